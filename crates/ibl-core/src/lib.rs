@@ -1,0 +1,23 @@
+//! Core types shared by every iblkit crate: linear RGB radiance, images with row 0 at the top,
+//! unit directions in the world frame (+Y up, -Z forward, +X right: the glTF frame), named frame
+//! presets, the lat-long parameterisation with exact texel solid angles, Fibonacci normals and
+//! summed-area tables.
+//!
+//! This crate does no I/O and knows no file formats; see `docs/CONVENTIONS.md` for every formula.
+
+pub mod direction;
+pub mod fibonacci;
+pub mod frame;
+pub mod image;
+pub mod latlong;
+pub mod rgb;
+pub mod summed_area;
+
+pub use direction::UnitDir;
+pub use fibonacci::fibonacci_normals;
+pub use frame::{EulerDegrees, FramePreset};
+pub use glam;
+pub use image::Image;
+pub use latlong::LatLong;
+pub use rgb::Rgb;
+pub use summed_area::SummedAreaTable;
