@@ -1,1 +1,63 @@
-fn main() {}
+//! `ibl`: the iblkit command line tool.
+//!
+//! Each subcommand lives in `src/cmd/`. Errors are reported as `ibl: <file>: <problem>` on stderr;
+//! the exit code is 2 for bad input or arguments and 1 for internal failures (see `failure.rs`).
+
+mod cmd;
+mod envmap_files;
+mod failure;
+mod progress;
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+/// Image-based lighting for augmented reality: light probes in, lights and renders out.
+#[derive(Parser)]
+#[command(name = "ibl", version, about, long_about = None, after_help = EXAMPLES)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+const EXAMPLES: &str = "\
+Examples:
+  ibl demo                                   run the main job on the bundled probes
+  ibl info assets/probes/esplanade.exr       statistics, power and brightest direction
+  ibl convert probe.hdr cube.exr --to cube-hcross
+  ibl preview probe.exr probe.png --tonemap aces
+
+Exit codes: 0 success, 1 internal failure, 2 bad input or arguments.";
+
+#[derive(Subcommand)]
+enum Command {
+    /// Describe an HDR image: format, size, mapping, statistics, power, brightest direction.
+    Info(cmd::info::InfoArgs),
+    /// Convert between file formats and environment-map mappings, with rotation.
+    Convert(cmd::convert::ConvertArgs),
+    /// Write a tone-mapped 8-bit preview (PNG or JPEG) of an HDR image.
+    Preview(cmd::preview::PreviewArgs),
+    /// Run the main job on the bundled probes and write everything to a folder.
+    Demo(cmd::demo::DemoArgs),
+}
+
+fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            // Help and version go to stdout with status 0; argument errors use status 2.
+            let _ = e.print();
+            return ExitCode::from(if e.use_stderr() { failure::EXIT_BAD_INPUT } else { 0 });
+        }
+    };
+    let result = match cli.command {
+        Command::Info(args) => cmd::info::run(&args),
+        Command::Convert(args) => cmd::convert::run(&args),
+        Command::Preview(args) => cmd::preview::run(&args),
+        Command::Demo(args) => cmd::demo::run(&args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(err) => failure::report(&err),
+    }
+}

@@ -1,0 +1,269 @@
+//! `ibl demo`: the main job on the bundled probes, with no arguments needed.
+//!
+//! For now (issue 2) it describes every bundled probe, writes a tone-mapped preview, shows each
+//! probe in every mapping (EXR plus preview), converts each back to lat-long and reports how much
+//! power the round trip kept. Everything lands in one folder with an `index.html` to look at and
+//! a `summary.json` for scripts.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+use clap::Args;
+use ibl_core::glam::Mat3;
+use ibl_core::{FramePreset, Rgb};
+use ibl_io::{Display, ToneCurve, WriteOptions};
+use ibl_mapping::{CubeLayout, Mapping};
+use serde::Serialize;
+
+use crate::cmd::info;
+use crate::envmap_files::{self, MappingArg};
+use crate::failure::usage;
+use crate::progress;
+
+/// Arguments of `ibl demo`.
+#[derive(Args)]
+#[command(after_help = "\
+Examples:
+  ibl demo                       writes ./demo-out (open demo-out/index.html)
+  ibl demo --out /tmp/ibl-demo
+  ibl demo --probes my-probes/   every .exr/.hdr lat-long probe in a folder")]
+pub struct DemoArgs {
+    /// Folder for all outputs (created if missing).
+    #[arg(long, default_value = "demo-out", value_name = "DIR")]
+    pub out: PathBuf,
+    /// Folder of lat-long probes to use (default: the bundled `assets/probes`).
+    #[arg(long, value_name = "DIR")]
+    pub probes: Option<PathBuf>,
+}
+
+/// The mappings the demo shows each probe in, with their file stems.
+fn demo_mappings() -> Vec<(&'static str, MappingArg)> {
+    vec![
+        ("angular", MappingArg::Single(Mapping::Angular)),
+        ("mirror-ball", MappingArg::Single(Mapping::MirrorBall)),
+        ("cube-hcross", MappingArg::Single(Mapping::Cube(CubeLayout::HorizontalCross))),
+        ("cube-vcross", MappingArg::Single(Mapping::Cube(CubeLayout::VerticalCross))),
+        ("cube-strip", MappingArg::Single(Mapping::Cube(CubeLayout::HorizontalStrip))),
+        ("cube-faces", MappingArg::CubeFaces),
+        ("fisheye-180", MappingArg::Single(Mapping::Fisheye { fov_deg: 180.0 })),
+        ("dual-fisheye-200", MappingArg::Single(Mapping::DualFisheye { fov_deg: 200.0 })),
+    ]
+}
+
+/// One mapping of one probe in the summary.
+#[derive(Serialize)]
+struct MappingResult {
+    mapping: String,
+    files: Vec<String>,
+    preview: String,
+    /// Relative change of total power (mean over channels) after converting back to lat-long,
+    /// percent; `None` for mappings that do not cover the whole sphere.
+    round_trip_power_change_pct: Option<f64>,
+}
+
+/// One probe in the summary.
+#[derive(Serialize)]
+struct ProbeResult {
+    name: String,
+    info: info::Info,
+    preview: String,
+    mappings: Vec<MappingResult>,
+}
+
+/// Finds the bundled probes: `assets/probes` beside the binary's source tree, else in the
+/// current folder.
+fn default_probe_dir() -> PathBuf {
+    let built_in = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/probes");
+    if built_in.is_dir() { built_in } else { PathBuf::from("assets/probes") }
+}
+
+/// Lat-long probes in a folder: `.exr` files (or `.hdr` where no `.exr` of that name exists).
+fn list_probes(dir: &Path) -> anyhow::Result<Vec<PathBuf>> {
+    let entries =
+        std::fs::read_dir(dir).with_context(|| format!("{}: cannot list probes", dir.display()))?;
+    let mut files: Vec<PathBuf> = entries
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| matches!(ibl_io::ImageFormat::from_path(p), Some(ibl_io::ImageFormat::Exr | ibl_io::ImageFormat::Hdr)))
+        .collect();
+    files.sort();
+    let exr_stems: Vec<PathBuf> = files
+        .iter()
+        .filter(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr")))
+        .map(|p| p.with_extension(""))
+        .collect();
+    files.retain(|p| {
+        p.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"))
+            || !exr_stems.contains(&p.with_extension(""))
+    });
+    if files.is_empty() {
+        return Err(usage(format!("{}: no .exr or .hdr probes found", dir.display())));
+    }
+    Ok(files)
+}
+
+/// Runs `ibl demo`.
+pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
+    let probe_dir = args.probes.clone().unwrap_or_else(default_probe_dir);
+    let probes = list_probes(&probe_dir)?;
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("{}: cannot create output folder", args.out.display()))?;
+    let mappings = demo_mappings();
+    let bar = progress::bar("demo", (probes.len() * (mappings.len() + 1)) as u64);
+    let mut results = Vec::new();
+    for path in &probes {
+        let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        bar.set_message(name.clone());
+        let result = demo_probe(path, &name, &args.out, &mappings, &bar)
+            .with_context(|| format!("demo on {}", path.display()))?;
+        results.push(result);
+    }
+    bar.finish_and_clear();
+    write_summary(&args.out, &results)?;
+    print_summary(&args.out, &results);
+    Ok(())
+}
+
+fn demo_probe(
+    path: &Path,
+    name: &str,
+    out: &Path,
+    mappings: &[(&'static str, MappingArg)],
+    bar: &indicatif::ProgressBar,
+) -> anyhow::Result<ProbeResult> {
+    let env = envmap_files::load(path, Some(MappingArg::Single(Mapping::LatLong)))?;
+    let info = info::describe(&env, false, FramePreset::Gltf, &path.display().to_string());
+    let dir = out.join(name);
+    std::fs::create_dir_all(&dir).with_context(|| format!("{}: cannot create", dir.display()))?;
+    let display = Display {
+        exposure_stops: ibl_io::tonemap::auto_exposure_stops(&env.image),
+        curve: ToneCurve::Reinhard,
+    };
+    let preview_opts = WriteOptions { display, ..Default::default() };
+    let preview = dir.join("latlong.png");
+    ibl_io::write_image(&preview, &env.image, &preview_opts)?;
+    std::fs::write(dir.join("info.json"), serde_json::to_string_pretty(&info)?)
+        .with_context(|| format!("{}: cannot write info.json", dir.display()))?;
+    bar.inc(1);
+
+    let power_before = ibl_mapping::power(&env.image, Mapping::LatLong);
+    let inputs = [path];
+    let mut results = Vec::new();
+    for (stem, to) in mappings {
+        let m = to.in_memory();
+        let (w, h) = m.default_size_for(Mapping::LatLong, env.image.width(), env.image.height());
+        let converted =
+            ibl_mapping::resample(&env.image, Mapping::LatLong, m, w, h, Mat3::IDENTITY, &|_, _| {})?;
+        let files = envmap_files::save(
+            &dir.join(format!("{stem}.exr")),
+            &converted,
+            *to,
+            &WriteOptions::default(),
+            &inputs,
+        )?;
+        let preview_path = dir.join(format!("{stem}.png"));
+        ibl_io::write_image(&preview_path, &converted, &preview_opts)?;
+        let covers_sphere = !matches!(m, Mapping::Fisheye { fov_deg } if fov_deg < 360.0);
+        let change = if covers_sphere {
+            let back = ibl_mapping::resample(
+                &converted,
+                m,
+                Mapping::LatLong,
+                env.image.width(),
+                env.image.height(),
+                Mat3::IDENTITY,
+                &|_, _| {},
+            )?;
+            let after = ibl_mapping::power(&back, Mapping::LatLong);
+            Some(relative_change_pct(&power_before, &after))
+        } else {
+            None
+        };
+        results.push(MappingResult {
+            mapping: to.name(),
+            files: files.iter().map(|p| relative(out, p)).collect(),
+            preview: relative(out, &preview_path),
+            round_trip_power_change_pct: change,
+        });
+        bar.inc(1);
+    }
+    Ok(ProbeResult { name: name.to_string(), info, preview: relative(out, &preview), mappings: results })
+}
+
+fn relative_change_pct(before: &[f64; 3], after: &[f64; 3]) -> f64 {
+    let mut sum = 0.0;
+    for c in 0..3 {
+        if before[c] > 0.0 {
+            sum += (after[c] - before[c]) / before[c];
+        }
+    }
+    100.0 * sum / 3.0
+}
+
+fn relative(base: &Path, p: &Path) -> String {
+    p.strip_prefix(base).unwrap_or(p).display().to_string()
+}
+
+fn write_summary(out: &Path, results: &[ProbeResult]) -> anyhow::Result<()> {
+    let json = serde_json::to_string_pretty(results)?;
+    std::fs::write(out.join("summary.json"), json)
+        .with_context(|| format!("{}: cannot write summary.json", out.display()))?;
+    let mut html = String::from(
+        "<!doctype html><meta charset=utf-8><title>iblkit demo</title>\
+         <style>body{font-family:sans-serif;background:#222;color:#ddd}img{max-height:220px;margin:4px;border:1px solid #444}\
+         figure{display:inline-block;margin:4px}figcaption{font-size:12px}td,th{padding:2px 8px;text-align:right}</style>\
+         <h1>iblkit demo</h1>",
+    );
+    for r in results {
+        let i = &r.info;
+        let _ = write!(
+            html,
+            "<h2>{}</h2><p>{} x {} {} &middot; power {:.4e} {:.4e} {:.4e} &middot; dynamic range {:.1} stops \
+             &middot; brightest ({:+.3}, {:+.3}, {:+.3}) &middot; {} negative / {} NaN-Inf values clamped</p>",
+            r.name, i.width, i.height, i.format, i.power[0], i.power[1], i.power[2], i.dynamic_range.stops,
+            i.brightest.direction[0], i.brightest.direction[1], i.brightest.direction[2],
+            i.negative_values, i.nonfinite_values
+        );
+        let _ = write!(html, "<figure><img src=\"{}\"><figcaption>latlong</figcaption></figure>", r.preview);
+        for m in &r.mappings {
+            let change = m
+                .round_trip_power_change_pct
+                .map(|c| format!(" (round trip {c:+.3} % power)"))
+                .unwrap_or_default();
+            let _ = write!(
+                html,
+                "<figure><img src=\"{}\"><figcaption>{}{change}</figcaption></figure>",
+                m.preview, m.mapping
+            );
+        }
+    }
+    std::fs::write(out.join("index.html"), html)
+        .with_context(|| format!("{}: cannot write index.html", out.display()))?;
+    Ok(())
+}
+
+fn print_summary(out: &Path, results: &[ProbeResult]) {
+    println!("{:<12} {:>9} {:>8} {:>12}  round-trip power change per mapping (%)", "probe", "size", "stops", "luminance");
+    for r in results {
+        let i = &r.info;
+        let power_lum = Rgb::new(i.power[0] as f32, i.power[1] as f32, i.power[2] as f32).luminance();
+        let changes: Vec<String> = r
+            .mappings
+            .iter()
+            .filter_map(|m| m.round_trip_power_change_pct.map(|c| format!("{} {c:+.3}", m.mapping)))
+            .collect();
+        println!(
+            "{:<12} {:>9} {:>8.1} {:>12.4e}  {}",
+            r.name,
+            format!("{}x{}", i.width, i.height),
+            i.dynamic_range.stops,
+            power_lum,
+            changes.join(", ")
+        );
+    }
+    println!();
+    println!("outputs in {}/", out.display());
+    println!("  {}/index.html     every probe in every mapping, tone-mapped", out.display());
+    println!("  {}/summary.json   the same as data", out.display());
+    println!("  {}/<probe>/       info.json, latlong.png, <mapping>.exr and .png", out.display());
+}

@@ -1,0 +1,76 @@
+//! `ibl preview`: an 8-bit sRGB picture of an HDR image, with exposure in stops and a tone curve.
+
+use std::path::PathBuf;
+
+use clap::{Args, ValueEnum};
+use ibl_io::{Display, ToneCurve, WriteOptions};
+
+use crate::failure::usage;
+
+/// A tone curve as named on the command line.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum CurveArg {
+    /// Clip at 1.
+    Clamp,
+    /// `x / (1 + x)`.
+    Reinhard,
+    /// ACES filmic (Narkowicz fit).
+    Aces,
+}
+
+impl From<CurveArg> for ToneCurve {
+    fn from(c: CurveArg) -> ToneCurve {
+        match c {
+            CurveArg::Clamp => ToneCurve::Clamp,
+            CurveArg::Reinhard => ToneCurve::Reinhard,
+            CurveArg::Aces => ToneCurve::AcesFilmic,
+        }
+    }
+}
+
+/// Arguments of `ibl preview`.
+#[derive(Args)]
+#[command(after_help = "\
+Without --exposure the exposure is automatic (the log-average luminance maps to middle grey).
+
+Examples:
+  ibl preview probe.exr probe.png
+  ibl preview probe.hdr probe.png --exposure -2 --tonemap clamp
+  ibl preview render.exr render.jpg --tonemap aces")]
+pub struct PreviewArgs {
+    /// HDR input.
+    pub input: PathBuf,
+    /// 8-bit output (.png or .jpg).
+    pub output: PathBuf,
+    /// Exposure in stops (the image is multiplied by 2^STOPS).
+    #[arg(long, value_name = "STOPS", allow_hyphen_values = true, conflicts_with = "auto_exposure")]
+    pub exposure: Option<f32>,
+    /// Choose the exposure from the image (the default when --exposure is not given).
+    #[arg(long)]
+    pub auto_exposure: bool,
+    /// Tone curve.
+    #[arg(long, value_enum, default_value = "reinhard")]
+    pub tonemap: CurveArg,
+}
+
+/// Runs `ibl preview`.
+pub fn run(args: &PreviewArgs) -> anyhow::Result<()> {
+    if let Some(e) = args.exposure
+        && !e.is_finite()
+    {
+        return Err(usage("--exposure must be a finite number of stops"));
+    }
+    if !matches!(
+        ibl_io::ImageFormat::from_path(&args.output),
+        Some(ibl_io::ImageFormat::Png | ibl_io::ImageFormat::Jpeg)
+    ) {
+        return Err(usage(format!("{}: a preview is written as .png or .jpg", args.output.display())));
+    }
+    ibl_io::ensure_output_is_not_input(&args.output, &[args.input.as_path()])?;
+    let loaded = ibl_io::read_image(&args.input)?;
+    let stops = args.exposure.unwrap_or_else(|| ibl_io::tonemap::auto_exposure_stops(&loaded.image));
+    let display = Display { exposure_stops: stops, curve: args.tonemap.into() };
+    ibl_io::write_image(&args.output, &loaded.image, &WriteOptions { display, ..Default::default() })?;
+    eprintln!("wrote {} (exposure {stops:+.2} stops, {:?})", args.output.display(), args.tonemap);
+    Ok(())
+}

@@ -1,0 +1,218 @@
+//! End-to-end tests of the `ibl` binary: JSON output, conversions, previews, the demo, exit codes,
+//! and the hostile-input corpus in `tests/hostile/` (every case must end in a clear error naming
+//! the file and exit code 2, or load with its invalid values counted; never a panic).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn ibl(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_ibl")).args(args).output().expect("run ibl")
+}
+
+fn repo() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn probe(name: &str) -> String {
+    repo().join("assets/probes").join(name).display().to_string()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+#[test]
+fn info_json_has_every_field_on_every_bundled_probe() {
+    for name in ["apartment", "esplanade", "sunset", "night"] {
+        for ext in ["exr", "hdr"] {
+            let path = probe(&format!("{name}.{ext}"));
+            let out = ibl(&["info", &path, "--json"]);
+            assert!(out.status.success(), "{path}: {}", stderr(&out));
+            let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
+            assert_eq!(v["width"], 512);
+            assert_eq!(v["height"], 256);
+            assert_eq!(v["format"], ext);
+            assert_eq!(v["mapping"], "latlong");
+            for key in ["min", "max", "mean", "power"] {
+                assert_eq!(v[key].as_array().map(Vec::len), Some(3), "{key}");
+            }
+            assert!(v["negative_values"].is_u64() && v["nonfinite_values"].is_u64());
+            let d: Vec<f64> =
+                v["brightest"]["direction"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
+            let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+            assert!((len - 1.0).abs() < 1e-4, "{path}: brightest direction not unit: {d:?}");
+            assert_eq!(v["brightest"]["pixel"].as_array().map(Vec::len), Some(2));
+            assert_eq!(v["brightest"]["radiance"].as_array().map(Vec::len), Some(3));
+            let power: Vec<f64> = v["power"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
+            assert!(power.iter().all(|p| *p > 0.0), "{path}: power {power:?}");
+        }
+    }
+}
+
+#[test]
+fn esplanade_sun_is_the_brightest_direction_and_above_the_horizon() {
+    let out = ibl(&["info", &probe("esplanade.exr"), "--json"]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let y = v["brightest"]["direction"][1].as_f64().unwrap();
+    let peak = v["brightest"]["radiance"][0].as_f64().unwrap();
+    assert!(y > 0.0, "sun below the horizon: {y}");
+    assert!(peak > 1000.0, "sun radiance {peak}");
+    // The .exr keeps DWAB's negative ringing; the tool must count it.
+    assert!(v["negative_values"].as_u64().unwrap() > 0);
+}
+
+#[test]
+fn info_text_names_the_mapping_guess() {
+    let out = ibl(&["info", &probe("night.hdr")]);
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("latlong") && text.contains("guessed"), "{text}");
+    assert!(text.contains("brightest"));
+}
+
+#[test]
+fn convert_between_formats_and_cube_faces_round_trips() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = |n: &str| dir.path().join(n).display().to_string();
+    let out = ibl(&["convert", &probe("sunset.hdr"), &d("a.pfm")]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let out = ibl(&["convert", &d("a.pfm"), &d("faces.exr"), "--to", "cube-faces"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    for face in ["px", "nx", "py", "ny", "pz", "nz"] {
+        assert!(dir.path().join(format!("faces_{face}.exr")).exists(), "{face}");
+    }
+    let pattern = d("faces_{face}.exr");
+    let out = ibl(&["convert", &pattern, &d("back.exr"), "--from", "cube-faces", "--to", "latlong", "--width", "512"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let power = |p: &str| -> Vec<f64> {
+        let o = ibl(&["info", p, "--json"]);
+        let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        v["power"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect()
+    };
+    let (a, b) = (power(&probe("sunset.hdr")), power(&d("back.exr")));
+    for c in 0..3 {
+        assert!((a[c] - b[c]).abs() / a[c] < 0.005, "channel {c}: {} vs {}", a[c], b[c]);
+    }
+}
+
+#[test]
+fn rotate_and_frame_are_accepted_and_checked() {
+    let dir = tempfile::tempdir().unwrap();
+    let out_path = dir.path().join("r.hdr").display().to_string();
+    let ok = ibl(&["convert", &probe("night.hdr"), &out_path, "--rotate", "-90,10,0", "--frame", "threejs"]);
+    assert!(ok.status.success(), "{}", stderr(&ok));
+    let bad = ibl(&["convert", &probe("night.hdr"), &out_path, "--rotate", "90,0"]);
+    assert_eq!(bad.status.code(), Some(2));
+    let bad = ibl(&["convert", &probe("night.hdr"), &out_path, "--frame", "maya"]);
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(stderr(&bad).contains("maya"));
+    let bad = ibl(&["convert", &probe("night.hdr"), &out_path, "--to", "octahedral"]);
+    assert_eq!(bad.status.code(), Some(2));
+}
+
+#[test]
+fn preview_writes_a_png() {
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("p.png");
+    let out = ibl(&["preview", &probe("apartment.exr"), png.to_str().unwrap(), "--tonemap", "aces"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let bytes = std::fs::read(&png).unwrap();
+    assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
+    let out = ibl(&["preview", &probe("apartment.exr"), png.to_str().unwrap(), "--exposure", "-3"]);
+    assert!(out.status.success());
+}
+
+#[test]
+fn never_writes_over_an_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let copy = dir.path().join("probe.hdr");
+    std::fs::copy(probe("night.hdr"), &copy).unwrap();
+    let before = std::fs::read(&copy).unwrap();
+    let c = copy.to_str().unwrap();
+    let out = ibl(&["convert", c, c]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("probe.hdr"));
+    assert_eq!(std::fs::read(&copy).unwrap(), before, "input changed");
+}
+
+#[test]
+fn missing_files_and_bad_arguments_exit_2() {
+    let out = ibl(&["info", "/nonexistent/probe.exr"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("/nonexistent/probe.exr"));
+    let out = ibl(&["info"]);
+    assert_eq!(out.status.code(), Some(2));
+    let out = ibl(&["frobnicate"]);
+    assert_eq!(out.status.code(), Some(2));
+    let out = ibl(&["--help"]);
+    assert_eq!(out.status.code(), Some(0));
+}
+
+#[test]
+fn every_help_has_examples() {
+    for cmd in ["info", "convert", "preview", "demo"] {
+        let out = ibl(&[cmd, "--help"]);
+        assert!(out.status.success());
+        assert!(String::from_utf8_lossy(&out.stdout).contains("Examples:"), "{cmd}");
+    }
+}
+
+/// Parses `tests/hostile/README.md`: lines `name | error|loads | what`.
+fn hostile_cases() -> Vec<(PathBuf, bool)> {
+    let dir = repo().join("tests/hostile");
+    let readme = std::fs::read_to_string(dir.join("README.md")).expect("tests/hostile/README.md");
+    let cases: Vec<(PathBuf, bool)> = readme
+        .lines()
+        .filter_map(|line| {
+            let cols: Vec<&str> = line.split('|').map(|c| c.trim().trim_matches('`')).collect();
+            if cols.len() < 3 || !matches!(cols[1], "error" | "loads") {
+                return None;
+            }
+            Some((dir.join(cols[0]), cols[1] == "error"))
+        })
+        .collect();
+    assert!(cases.len() >= 15, "hostile corpus too small: {}", cases.len());
+    cases
+}
+
+#[test]
+fn hostile_corpus_gives_clear_errors_and_exit_2() {
+    for (path, must_fail) in hostile_cases() {
+        assert!(path.exists(), "{} listed but missing", path.display());
+        let p = path.display().to_string();
+        let out = ibl(&["info", &p]);
+        let err = stderr(&out);
+        assert!(!err.contains("panicked"), "{p}: panic: {err}");
+        if must_fail {
+            assert_eq!(out.status.code(), Some(2), "{p}: expected exit 2, stderr: {err}");
+            let name = path.file_name().unwrap().to_string_lossy();
+            assert!(err.contains(name.as_ref()), "{p}: message does not name the file: {err}");
+        } else {
+            assert_eq!(out.status.code(), Some(0), "{p}: expected to load: {err}");
+        }
+    }
+}
+
+#[test]
+fn demo_writes_every_mapping_and_an_index() {
+    let dir = tempfile::tempdir().unwrap();
+    let out_dir = dir.path().join("demo");
+    let out = ibl(&["demo", "--out", out_dir.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains(out_dir.to_str().unwrap()), "demo must say where its outputs are");
+    assert!(out_dir.join("index.html").exists());
+    let summary: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out_dir.join("summary.json")).unwrap()).unwrap();
+    let probes = summary.as_array().unwrap();
+    assert_eq!(probes.len(), 4);
+    for p in probes {
+        for m in p["mappings"].as_array().unwrap() {
+            assert!(out_dir.join(m["preview"].as_str().unwrap()).exists());
+            if let Some(change) = m["round_trip_power_change_pct"].as_f64() {
+                assert!(change.abs() < 0.5, "{} {}: {change} %", p["name"], m["mapping"]);
+            }
+        }
+    }
+    assert!(Path::new(&out_dir.join("esplanade/cube-faces_px.exr")).exists());
+}
