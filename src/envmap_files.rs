@@ -79,7 +79,10 @@ pub fn face_paths(pattern: &Path) -> Vec<PathBuf> {
             if text.contains("{face}") {
                 PathBuf::from(text.replace("{face}", face))
             } else {
-                let stem = pattern.file_stem().map(|s| s.to_string_lossy()).unwrap_or_default();
+                let stem = pattern
+                    .file_stem()
+                    .map(|s| s.to_string_lossy())
+                    .unwrap_or_default();
                 let name = match pattern.extension() {
                     Some(ext) => format!("{stem}_{face}.{}", ext.to_string_lossy()),
                     None => format!("{stem}_{face}"),
@@ -95,7 +98,12 @@ pub fn load(path: &Path, mapping: Option<MappingArg>) -> anyhow::Result<LoadedEn
     if mapping == Some(MappingArg::CubeFaces) {
         return load_faces(path);
     }
-    let LoadedImage { image, format, report, details } = ibl_io::read_image(path)?;
+    let LoadedImage {
+        image,
+        format,
+        report,
+        details,
+    } = ibl_io::read_image(path)?;
     let mapping = match mapping {
         Some(m) => m.in_memory(),
         None => Mapping::guess_from_shape(image.width(), image.height()),
@@ -103,7 +111,14 @@ pub fn load(path: &Path, mapping: Option<MappingArg>) -> anyhow::Result<LoadedEn
     mapping
         .check_shape(image.width(), image.height())
         .with_context(|| format!("{}: not a {} image", path.display(), mapping.name()))?;
-    Ok(LoadedEnv { image, mapping, format, details, report, files: vec![path.to_path_buf()] })
+    Ok(LoadedEnv {
+        image,
+        mapping,
+        format,
+        details,
+        report,
+        files: vec![path.to_path_buf()],
+    })
 }
 
 fn load_faces(pattern: &Path) -> anyhow::Result<LoadedEnv> {

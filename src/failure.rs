@@ -32,5 +32,9 @@ pub fn is_bad_input(err: &anyhow::Error) -> bool {
 /// Prints `ibl: <error>: <cause>...` to stderr and returns the exit code for it.
 pub fn report(err: &anyhow::Error) -> ExitCode {
     eprintln!("ibl: {err:#}");
-    ExitCode::from(if is_bad_input(err) { EXIT_BAD_INPUT } else { EXIT_INTERNAL })
+    ExitCode::from(if is_bad_input(err) {
+        EXIT_BAD_INPUT
+    } else {
+        EXIT_INTERNAL
+    })
 }

@@ -47,7 +47,11 @@ fn main() -> ExitCode {
         Err(e) => {
             // Help and version go to stdout with status 0; argument errors use status 2.
             let _ = e.print();
-            return ExitCode::from(if e.use_stderr() { failure::EXIT_BAD_INPUT } else { 0 });
+            return ExitCode::from(if e.use_stderr() {
+                failure::EXIT_BAD_INPUT
+            } else {
+                0
+            });
         }
     };
     let result = match cli.command {

@@ -72,7 +72,11 @@ pub struct ConvertArgs {
 /// Parses `Y,P,R` degrees.
 pub fn parse_rotation(text: &str) -> anyhow::Result<EulerDegrees> {
     let parts: Vec<&str> = text.split(',').map(str::trim).collect();
-    let bad = || usage(format!("--rotate `{text}`: expected three angles in degrees, e.g. 90,0,0"));
+    let bad = || {
+        usage(format!(
+            "--rotate `{text}`: expected three angles in degrees, e.g. 90,0,0"
+        ))
+    };
     if parts.len() != 3 {
         return Err(bad());
     }
@@ -83,19 +87,30 @@ pub fn parse_rotation(text: &str) -> anyhow::Result<EulerDegrees> {
             return Err(bad());
         }
     }
-    Ok(EulerDegrees { yaw_deg: v[0], pitch_deg: v[1], roll_deg: v[2] })
+    Ok(EulerDegrees {
+        yaw_deg: v[0],
+        pitch_deg: v[1],
+        roll_deg: v[2],
+    })
 }
 
 /// Looks up a frame preset by name, as a usage error when unknown.
 pub fn parse_frame(name: &str) -> anyhow::Result<FramePreset> {
-    FramePreset::from_name(name)
-        .ok_or_else(|| usage(format!("unknown frame `{name}` (gltf, paper, threejs, blender)")))
+    FramePreset::from_name(name).ok_or_else(|| {
+        usage(format!(
+            "unknown frame `{name}` (gltf, paper, threejs, blender)"
+        ))
+    })
 }
 
 /// EXR options from the command line.
 pub fn exr_options(precision: &str, compression: &str) -> ExrOptions {
     ExrOptions {
-        precision: if precision == "half" { ExrPrecision::Half } else { ExrPrecision::Float },
+        precision: if precision == "half" {
+            ExrPrecision::Half
+        } else {
+            ExrPrecision::Float
+        },
         compression: match compression {
             "none" => ExrCompression::None,
             "rle" => ExrCompression::Rle,
@@ -113,7 +128,12 @@ pub fn run(args: &ConvertArgs) -> anyhow::Result<()> {
         .as_deref()
         .map(|m| MappingArg::parse(m, args.from_fov.unwrap_or(args.fov)))
         .transpose()?;
-    let rotation = args.rotate.as_deref().map(parse_rotation).transpose()?.unwrap_or_default();
+    let rotation = args
+        .rotate
+        .as_deref()
+        .map(parse_rotation)
+        .transpose()?
+        .unwrap_or_default();
     let out_frame = parse_frame(&args.frame)?;
     let in_frame = parse_frame(&args.from_frame)?;
     if args.width == Some(0) {
@@ -151,7 +171,13 @@ pub fn run(args: &ConvertArgs) -> anyhow::Result<()> {
     let inputs: Vec<&std::path::Path> = env.files.iter().map(PathBuf::as_path).collect();
     let written = envmap_files::save(&args.output, &out, to, &options, &inputs)?;
     for p in written {
-        eprintln!("wrote {} ({} x {}, {})", p.display(), out.width(), out.height(), to.name());
+        eprintln!(
+            "wrote {} ({} x {}, {})",
+            p.display(),
+            out.width(),
+            out.height(),
+            to.name()
+        );
     }
     Ok(())
 }
@@ -162,7 +188,10 @@ pub fn report_clamped(env: &envmap_files::LoadedEnv) {
     if r.negative_values + r.nonfinite_values > 0 {
         eprintln!(
             "note: {}: clamped {} negative and {} NaN/Inf values to 0",
-            env.files.first().map(|p| p.display().to_string()).unwrap_or_default(),
+            env.files
+                .first()
+                .map(|p| p.display().to_string())
+                .unwrap_or_default(),
             r.negative_values,
             r.nonfinite_values
         );

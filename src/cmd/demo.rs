@@ -42,12 +42,27 @@ fn demo_mappings() -> Vec<(&'static str, MappingArg)> {
     vec![
         ("angular", MappingArg::Single(Mapping::Angular)),
         ("mirror-ball", MappingArg::Single(Mapping::MirrorBall)),
-        ("cube-hcross", MappingArg::Single(Mapping::Cube(CubeLayout::HorizontalCross))),
-        ("cube-vcross", MappingArg::Single(Mapping::Cube(CubeLayout::VerticalCross))),
-        ("cube-strip", MappingArg::Single(Mapping::Cube(CubeLayout::HorizontalStrip))),
+        (
+            "cube-hcross",
+            MappingArg::Single(Mapping::Cube(CubeLayout::HorizontalCross)),
+        ),
+        (
+            "cube-vcross",
+            MappingArg::Single(Mapping::Cube(CubeLayout::VerticalCross)),
+        ),
+        (
+            "cube-strip",
+            MappingArg::Single(Mapping::Cube(CubeLayout::HorizontalStrip)),
+        ),
         ("cube-faces", MappingArg::CubeFaces),
-        ("fisheye-180", MappingArg::Single(Mapping::Fisheye { fov_deg: 180.0 })),
-        ("dual-fisheye-200", MappingArg::Single(Mapping::DualFisheye { fov_deg: 200.0 })),
+        (
+            "fisheye-180",
+            MappingArg::Single(Mapping::Fisheye { fov_deg: 180.0 }),
+        ),
+        (
+            "dual-fisheye-200",
+            MappingArg::Single(Mapping::DualFisheye { fov_deg: 200.0 }),
+        ),
     ]
 }
 
@@ -75,7 +90,11 @@ struct ProbeResult {
 /// current folder.
 fn default_probe_dir() -> PathBuf {
     let built_in = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/probes");
-    if built_in.is_dir() { built_in } else { PathBuf::from("assets/probes") }
+    if built_in.is_dir() {
+        built_in
+    } else {
+        PathBuf::from("assets/probes")
+    }
 }
 
 /// Lat-long probes in a folder: `.exr` files (or `.hdr` where no `.exr` of that name exists).
@@ -84,7 +103,12 @@ fn list_probes(dir: &Path) -> anyhow::Result<Vec<PathBuf>> {
         std::fs::read_dir(dir).with_context(|| format!("{}: cannot list probes", dir.display()))?;
     let mut files: Vec<PathBuf> = entries
         .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| matches!(ibl_io::ImageFormat::from_path(p), Some(ibl_io::ImageFormat::Exr | ibl_io::ImageFormat::Hdr)))
+        .filter(|p| {
+            matches!(
+                ibl_io::ImageFormat::from_path(p),
+                Some(ibl_io::ImageFormat::Exr | ibl_io::ImageFormat::Hdr)
+            )
+        })
         .collect();
     files.sort();
     let exr_stems: Vec<PathBuf> = files
@@ -97,7 +121,10 @@ fn list_probes(dir: &Path) -> anyhow::Result<Vec<PathBuf>> {
             || !exr_stems.contains(&p.with_extension(""))
     });
     if files.is_empty() {
-        return Err(usage(format!("{}: no .exr or .hdr probes found", dir.display())));
+        return Err(usage(format!(
+            "{}: no .exr or .hdr probes found",
+            dir.display()
+        )));
     }
     Ok(files)
 }
@@ -112,7 +139,10 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
     let bar = progress::bar("demo", (probes.len() * (mappings.len() + 1)) as u64);
     let mut results = Vec::new();
     for path in &probes {
-        let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        let name = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
         bar.set_message(name.clone());
         let result = demo_probe(path, &name, &args.out, &mappings, &bar)
             .with_context(|| format!("demo on {}", path.display()))?;
@@ -139,7 +169,10 @@ fn demo_probe(
         exposure_stops: ibl_io::tonemap::auto_exposure_stops(&env.image),
         curve: ToneCurve::Reinhard,
     };
-    let preview_opts = WriteOptions { display, ..Default::default() };
+    let preview_opts = WriteOptions {
+        display,
+        ..Default::default()
+    };
     let preview = dir.join("latlong.png");
     ibl_io::write_image(&preview, &env.image, &preview_opts)?;
     std::fs::write(dir.join("info.json"), serde_json::to_string_pretty(&info)?)
@@ -152,8 +185,15 @@ fn demo_probe(
     for (stem, to) in mappings {
         let m = to.in_memory();
         let (w, h) = m.default_size_for(Mapping::LatLong, env.image.width(), env.image.height());
-        let converted =
-            ibl_mapping::resample(&env.image, Mapping::LatLong, m, w, h, Mat3::IDENTITY, &|_, _| {})?;
+        let converted = ibl_mapping::resample(
+            &env.image,
+            Mapping::LatLong,
+            m,
+            w,
+            h,
+            Mat3::IDENTITY,
+            &|_, _| {},
+        )?;
         let files = envmap_files::save(
             &dir.join(format!("{stem}.exr")),
             &converted,
@@ -187,7 +227,12 @@ fn demo_probe(
         });
         bar.inc(1);
     }
-    Ok(ProbeResult { name: name.to_string(), info, preview: relative(out, &preview), mappings: results })
+    Ok(ProbeResult {
+        name: name.to_string(),
+        info,
+        preview: relative(out, &preview),
+        mappings: results,
+    })
 }
 
 fn relative_change_pct(before: &[f64; 3], after: &[f64; 3]) -> f64 {
@@ -220,11 +265,25 @@ fn write_summary(out: &Path, results: &[ProbeResult]) -> anyhow::Result<()> {
             html,
             "<h2>{}</h2><p>{} x {} {} &middot; power {:.4e} {:.4e} {:.4e} &middot; dynamic range {:.1} stops \
              &middot; brightest ({:+.3}, {:+.3}, {:+.3}) &middot; {} negative / {} NaN-Inf values clamped</p>",
-            r.name, i.width, i.height, i.format, i.power[0], i.power[1], i.power[2], i.dynamic_range.stops,
-            i.brightest.direction[0], i.brightest.direction[1], i.brightest.direction[2],
-            i.negative_values, i.nonfinite_values
+            r.name,
+            i.width,
+            i.height,
+            i.format,
+            i.power[0],
+            i.power[1],
+            i.power[2],
+            i.dynamic_range.stops,
+            i.brightest.direction[0],
+            i.brightest.direction[1],
+            i.brightest.direction[2],
+            i.negative_values,
+            i.nonfinite_values
         );
-        let _ = write!(html, "<figure><img src=\"{}\"><figcaption>latlong</figcaption></figure>", r.preview);
+        let _ = write!(
+            html,
+            "<figure><img src=\"{}\"><figcaption>latlong</figcaption></figure>",
+            r.preview
+        );
         for m in &r.mappings {
             let change = m
                 .round_trip_power_change_pct
@@ -243,14 +302,21 @@ fn write_summary(out: &Path, results: &[ProbeResult]) -> anyhow::Result<()> {
 }
 
 fn print_summary(out: &Path, results: &[ProbeResult]) {
-    println!("{:<12} {:>9} {:>8} {:>12}  round-trip power change per mapping (%)", "probe", "size", "stops", "luminance");
+    println!(
+        "{:<12} {:>9} {:>8} {:>12}  round-trip power change per mapping (%)",
+        "probe", "size", "stops", "luminance"
+    );
     for r in results {
         let i = &r.info;
-        let power_lum = Rgb::new(i.power[0] as f32, i.power[1] as f32, i.power[2] as f32).luminance();
+        let power_lum =
+            Rgb::new(i.power[0] as f32, i.power[1] as f32, i.power[2] as f32).luminance();
         let changes: Vec<String> = r
             .mappings
             .iter()
-            .filter_map(|m| m.round_trip_power_change_pct.map(|c| format!("{} {c:+.3}", m.mapping)))
+            .filter_map(|m| {
+                m.round_trip_power_change_pct
+                    .map(|c| format!("{} {c:+.3}", m.mapping))
+            })
             .collect();
         println!(
             "{:<12} {:>9} {:>8.1} {:>12.4e}  {}",
@@ -263,7 +329,13 @@ fn print_summary(out: &Path, results: &[ProbeResult]) {
     }
     println!();
     println!("outputs in {}/", out.display());
-    println!("  {}/index.html     every probe in every mapping, tone-mapped", out.display());
+    println!(
+        "  {}/index.html     every probe in every mapping, tone-mapped",
+        out.display()
+    );
     println!("  {}/summary.json   the same as data", out.display());
-    println!("  {}/<probe>/       info.json, latlong.png, <mapping>.exr and .png", out.display());
+    println!(
+        "  {}/<probe>/       info.json, latlong.png, <mapping>.exr and .png",
+        out.display()
+    );
 }

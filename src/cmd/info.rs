@@ -102,12 +102,24 @@ pub struct Info {
 
 /// Runs `ibl info`.
 pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
-    let mapping_arg =
-        args.mapping.as_deref().map(|m| MappingArg::parse(m, args.fov)).transpose()?;
-    let frame = FramePreset::from_name(&args.frame)
-        .ok_or_else(|| usage(format!("unknown frame `{}` (gltf, paper, threejs, blender)", args.frame)))?;
+    let mapping_arg = args
+        .mapping
+        .as_deref()
+        .map(|m| MappingArg::parse(m, args.fov))
+        .transpose()?;
+    let frame = FramePreset::from_name(&args.frame).ok_or_else(|| {
+        usage(format!(
+            "unknown frame `{}` (gltf, paper, threejs, blender)",
+            args.frame
+        ))
+    })?;
     let env = envmap_files::load(&args.file, mapping_arg)?;
-    let info = describe(&env, mapping_arg.is_none(), frame, &args.file.display().to_string());
+    let info = describe(
+        &env,
+        mapping_arg.is_none(),
+        frame,
+        &args.file.display().to_string(),
+    );
     if args.json {
         println!("{}", serde_json::to_string_pretty(&info)?);
     } else {
@@ -117,7 +129,12 @@ pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
 }
 
 /// Computes the statistics of a loaded environment map. Cost O(W H).
-pub fn describe(env: &envmap_files::LoadedEnv, guessed: bool, frame: FramePreset, file: &str) -> Info {
+pub fn describe(
+    env: &envmap_files::LoadedEnv,
+    guessed: bool,
+    frame: FramePreset,
+    file: &str,
+) -> Info {
     let img = &env.image;
     let (w, h) = (img.width(), img.height());
     let solid = env.mapping.texel_solid_angles(w, h);
@@ -125,7 +142,12 @@ pub fn describe(env: &envmap_files::LoadedEnv, guessed: bool, frame: FramePreset
     let power = ibl_mapping::power(img, env.mapping);
     let dir = env
         .mapping
-        .pixel_dir(w, h, stats.brightest.0 as f64 + 0.5, stats.brightest.1 as f64 + 0.5)
+        .pixel_dir(
+            w,
+            h,
+            stats.brightest.0 as f64 + 0.5,
+            stats.brightest.1 as f64 + 0.5,
+        )
         .map(|d| frame.preset_from_world() * d.as_vec3())
         .unwrap_or_default();
     let b = *img.get(stats.brightest.0, stats.brightest.1);
@@ -150,7 +172,11 @@ pub fn describe(env: &envmap_files::LoadedEnv, guessed: bool, frame: FramePreset
         nonfinite_values: env.report.nonfinite_values,
         power,
         dynamic_range: DynamicRange {
-            min_positive_luminance: if stats.min_pos_lum.is_finite() { stats.min_pos_lum } else { 0.0 },
+            min_positive_luminance: if stats.min_pos_lum.is_finite() {
+                stats.min_pos_lum
+            } else {
+                0.0
+            },
             max_luminance: stats.max_lum,
             ratio,
             stops: ratio.log2(),
@@ -218,16 +244,32 @@ fn channel_stats(img: &Image<Rgb>, solid: &Image<f64>) -> ChannelStats {
 }
 
 fn print_text(i: &Info) {
-    let guessed = if i.mapping_guessed { " (guessed from shape; --mapping to override)" } else { "" };
+    let guessed = if i.mapping_guessed {
+        " (guessed from shape; --mapping to override)"
+    } else {
+        ""
+    };
     println!("file        {}", i.file);
     println!("format      {} ({})", i.format, i.encoding);
     println!("size        {} x {}", i.width, i.height);
     println!("mapping     {}{guessed}", i.mapping);
     println!("             {:>12} {:>12} {:>12}", "R", "G", "B");
-    println!("min         {:>12.5e} {:>12.5e} {:>12.5e}", i.min[0], i.min[1], i.min[2]);
-    println!("max         {:>12.5e} {:>12.5e} {:>12.5e}", i.max[0], i.max[1], i.max[2]);
-    println!("mean        {:>12.5e} {:>12.5e} {:>12.5e}", i.mean[0], i.mean[1], i.mean[2]);
-    println!("power       {:>12.5e} {:>12.5e} {:>12.5e}   (sum L dOmega)", i.power[0], i.power[1], i.power[2]);
+    println!(
+        "min         {:>12.5e} {:>12.5e} {:>12.5e}",
+        i.min[0], i.min[1], i.min[2]
+    );
+    println!(
+        "max         {:>12.5e} {:>12.5e} {:>12.5e}",
+        i.max[0], i.max[1], i.max[2]
+    );
+    println!(
+        "mean        {:>12.5e} {:>12.5e} {:>12.5e}",
+        i.mean[0], i.mean[1], i.mean[2]
+    );
+    println!(
+        "power       {:>12.5e} {:>12.5e} {:>12.5e}   (sum L dOmega)",
+        i.power[0], i.power[1], i.power[2]
+    );
     let dr = &i.dynamic_range;
     println!(
         "range       luminance {:.3e} .. {:.3e}: {:.3e}:1 ({:.1} stops)",
@@ -240,7 +282,14 @@ fn print_text(i: &Info) {
     let b = &i.brightest;
     println!(
         "brightest   direction ({:+.4}, {:+.4}, {:+.4}) [{} axes], pixel ({}, {}), radiance ({:.4e}, {:.4e}, {:.4e})",
-        b.direction[0], b.direction[1], b.direction[2], i.frame, b.pixel[0], b.pixel[1],
-        b.radiance[0], b.radiance[1], b.radiance[2]
+        b.direction[0],
+        b.direction[1],
+        b.direction[2],
+        i.frame,
+        b.pixel[0],
+        b.pixel[1],
+        b.radiance[0],
+        b.radiance[1],
+        b.radiance[2]
     );
 }

@@ -43,7 +43,12 @@ pub struct PreviewArgs {
     /// 8-bit output (.png or .jpg).
     pub output: PathBuf,
     /// Exposure in stops (the image is multiplied by 2^STOPS).
-    #[arg(long, value_name = "STOPS", allow_hyphen_values = true, conflicts_with = "auto_exposure")]
+    #[arg(
+        long,
+        value_name = "STOPS",
+        allow_hyphen_values = true,
+        conflicts_with = "auto_exposure"
+    )]
     pub exposure: Option<f32>,
     /// Choose the exposure from the image (the default when --exposure is not given).
     #[arg(long)]
@@ -64,13 +69,32 @@ pub fn run(args: &PreviewArgs) -> anyhow::Result<()> {
         ibl_io::ImageFormat::from_path(&args.output),
         Some(ibl_io::ImageFormat::Png | ibl_io::ImageFormat::Jpeg)
     ) {
-        return Err(usage(format!("{}: a preview is written as .png or .jpg", args.output.display())));
+        return Err(usage(format!(
+            "{}: a preview is written as .png or .jpg",
+            args.output.display()
+        )));
     }
     ibl_io::ensure_output_is_not_input(&args.output, &[args.input.as_path()])?;
     let loaded = ibl_io::read_image(&args.input)?;
-    let stops = args.exposure.unwrap_or_else(|| ibl_io::tonemap::auto_exposure_stops(&loaded.image));
-    let display = Display { exposure_stops: stops, curve: args.tonemap.into() };
-    ibl_io::write_image(&args.output, &loaded.image, &WriteOptions { display, ..Default::default() })?;
-    eprintln!("wrote {} (exposure {stops:+.2} stops, {:?})", args.output.display(), args.tonemap);
+    let stops = args
+        .exposure
+        .unwrap_or_else(|| ibl_io::tonemap::auto_exposure_stops(&loaded.image));
+    let display = Display {
+        exposure_stops: stops,
+        curve: args.tonemap.into(),
+    };
+    ibl_io::write_image(
+        &args.output,
+        &loaded.image,
+        &WriteOptions {
+            display,
+            ..Default::default()
+        },
+    )?;
+    eprintln!(
+        "wrote {} (exposure {stops:+.2} stops, {:?})",
+        args.output.display(),
+        args.tonemap
+    );
     Ok(())
 }

@@ -49,7 +49,7 @@ impl LatLong {
     /// need not be normalised; a zero vector maps to the zenith.
     pub fn dir_to_uv(d: DVec3) -> (f64, f64) {
         let len = d.length();
-        if !(len > 0.0) {
+        if len.is_nan() || len <= 0.0 {
             return (0.5, 0.0);
         }
         let theta = (d.y / len).clamp(-1.0, 1.0).acos();

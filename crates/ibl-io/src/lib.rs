@@ -1,1 +1,203 @@
-//! stub
+//! File formats for iblkit: Radiance RGBE (`.hdr`), OpenEXR, PFM, PNG and JPEG in; the same out
+//! (PNG/JPEG through a tone-mapping display transform); all presented as linear radiance
+//! `Image<Rgb>` with row 0 at the top (`docs/CONVENTIONS.md`, sections 2, 4 and 7).
+//!
+//! - [`read_image`] picks the decoder by extension, checks header sizes against [`Limits`] (and
+//!   against what the file can hold) before allocating, decodes, then clamps negative, NaN and
+//!   infinite values to 0 and counts them in a [`SanitizeReport`].
+//! - [`write_image`] encodes by extension and writes atomically (temporary file + rename);
+//!   [`ensure_output_is_not_input`] refuses to overwrite an input.
+//! - The per-format modules ([`hdr`], [`exr`], [`pfm`], [`ldr`]) are pure byte-level codecs
+//!   (`decode(bytes, limits) -> RawImage`, `encode(image) -> bytes`), for fuzzing and benches.
+//!
+//! Errors name the file and say whether the input was at fault ([`IoError::is_bad_input`]).
+//! The library never prints and never panics on file content.
+//!
+//! Writes go to a temporary file in the output's own directory which is then renamed over the
+//! destination, so a reader never sees a half-written file and a failed write leaves any previous
+//! file untouched (`docs/CONVENTIONS.md`, section 7).
+
+mod error;
+pub mod exr;
+mod format;
+pub mod hdr;
+pub mod ldr;
+pub mod pfm;
+pub mod sanitize;
+pub mod tonemap;
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use ibl_core::{Image, Rgb};
+
+pub use error::{DecodeError, EncodeError, IoError};
+pub use exr::{ExrCompression, ExrOptions, ExrPrecision};
+pub use format::{ImageFormat, Limits, RawImage};
+pub use sanitize::{SanitizeReport, sanitize};
+pub use tonemap::{Display, ToneCurve};
+
+use tonemap::to_srgb8;
+
+/// An image read from a file, with what reading did to it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LoadedImage {
+    /// Linear radiance, row 0 at the top; negative, NaN and infinite values clamped to 0.
+    pub image: Image<Rgb>,
+    /// The file's format (from its extension).
+    pub format: ImageFormat,
+    /// How many values were clamped.
+    pub report: SanitizeReport,
+    /// Human-readable encoding, e.g. `"OpenEXR, ZIP, half"` or `"Radiance RGBE, RLE"`.
+    pub details: String,
+}
+
+/// How [`write_image`] encodes each format.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct WriteOptions {
+    /// Precision and compression of `.exr` output.
+    pub exr: ExrOptions,
+    /// Exposure and tone curve of `.png`/`.jpg` output.
+    pub display: Display,
+}
+
+fn format_of(path: &Path) -> Result<ImageFormat, IoError> {
+    ImageFormat::from_path(path).ok_or_else(|| IoError::Unsupported {
+        path: path.to_path_buf(),
+        what: "file extension (expected .hdr, .pic, .exr, .pfm, .png, .jpg or .jpeg)".into(),
+    })
+}
+
+/// Decodes bytes of a known format (no sanitising).
+fn decode(format: ImageFormat, bytes: &[u8], limits: &Limits) -> Result<RawImage, DecodeError> {
+    match format {
+        ImageFormat::Hdr => hdr::decode(bytes, limits),
+        ImageFormat::Exr => exr::decode(bytes, limits),
+        ImageFormat::Pfm => pfm::decode(bytes, limits),
+        ImageFormat::Png | ImageFormat::Jpeg => ldr::decode(bytes, limits),
+    }
+}
+
+/// Reads an image file with the default [`Limits`].
+pub fn read_image(path: &Path) -> Result<LoadedImage, IoError> {
+    read_image_with_limits(path, &Limits::default())
+}
+
+/// Reads an image file: the format comes from the extension; sizes are checked against `limits`
+/// before allocating; negative, NaN and infinite values are clamped to 0 and counted.
+pub fn read_image_with_limits(path: &Path, limits: &Limits) -> Result<LoadedImage, IoError> {
+    let format = format_of(path)?;
+    let bytes = std::fs::read(path).map_err(|e| IoError::read(path, e))?;
+    let raw = decode(format, &bytes, limits).map_err(|e| e.with_path(path))?;
+    drop(bytes);
+    let mut image = raw.image;
+    let report = sanitize(&mut image);
+    Ok(LoadedImage {
+        image,
+        format,
+        report,
+        details: raw.details,
+    })
+}
+
+/// Encodes an image for a format: `.hdr` RLE, `.exr` per `options.exr`, `.pfm` little-endian,
+/// `.png`/`.jpg` tone-mapped with `options.display` (JPEG quality 92).
+pub fn encode_image(
+    format: ImageFormat,
+    image: &Image<Rgb>,
+    options: &WriteOptions,
+) -> Result<Vec<u8>, EncodeError> {
+    if image.is_empty() {
+        return Err(EncodeError::new("cannot write an empty image"));
+    }
+    match format {
+        ImageFormat::Hdr => Ok(hdr::encode(image)),
+        ImageFormat::Exr => exr::encode(image, &options.exr),
+        ImageFormat::Pfm => Ok(pfm::encode(image, pfm::ByteOrder::LittleEndian)),
+        ImageFormat::Png => ldr::encode_png(&to_srgb8(image, &options.display)),
+        ImageFormat::Jpeg => {
+            ldr::encode_jpeg(&to_srgb8(image, &options.display), ldr::JPEG_QUALITY)
+        }
+    }
+}
+
+/// Writes an image, choosing the format by extension, atomically: the bytes go to a temporary
+/// file in the same directory which is synced and then renamed over `path` (mode 0644 on Unix).
+pub fn write_image(path: &Path, image: &Image<Rgb>, options: &WriteOptions) -> Result<(), IoError> {
+    let format = format_of(path)?;
+    let bytes = encode_image(format, image, options).map_err(|e| e.with_path(path))?;
+    write_atomically(path, &bytes)
+}
+
+/// Writes `bytes` to `path` through a temporary file in the same directory, synced, then renamed
+/// over `path` (mode 0644 on Unix); also useful for non-image outputs such as JSON.
+pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), IoError> {
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let err = |e| IoError::write(path, e);
+    let mut tmp = tempfile::Builder::new()
+        .prefix(".iblkit-")
+        .suffix(".tmp")
+        .tempfile_in(dir)
+        .map_err(err)?;
+    tmp.write_all(bytes).map_err(err)?;
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        tmp.as_file()
+            .set_permissions(std::fs::Permissions::from_mode(0o644))
+            .map_err(err)?;
+    }
+    tmp.as_file().sync_all().map_err(err)?;
+    tmp.persist(path).map_err(|e| err(e.error))?;
+    Ok(())
+}
+
+/// `path` made absolute with symlinks resolved; for a file that does not exist yet, its parent
+/// is resolved and the file name appended. `None` when even the parent cannot be resolved.
+fn resolve(path: &Path) -> Option<PathBuf> {
+    if let Ok(p) = path.canonicalize() {
+        return Some(p);
+    }
+    let name = path.file_name()?;
+    let parent = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    Some(parent.canonicalize().ok()?.join(name))
+}
+
+#[cfg(unix)]
+fn same_inode(a: &Path, b: &Path) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    match (std::fs::metadata(a), std::fs::metadata(b)) {
+        (Ok(a), Ok(b)) => a.dev() == b.dev() && a.ino() == b.ino(),
+        _ => false,
+    }
+}
+
+#[cfg(not(unix))]
+fn same_inode(_: &Path, _: &Path) -> bool {
+    false
+}
+
+/// Fails with [`IoError::SameAsInput`] if `output` names the same file as any of `inputs`
+/// (same canonical path, through symlinks and `..`, or the same inode through a hard link).
+/// Inputs that do not exist are ignored.
+pub fn ensure_output_is_not_input(output: &Path, inputs: &[&Path]) -> Result<(), IoError> {
+    let out = resolve(output);
+    for input in inputs {
+        let same_path = match (&out, input.canonicalize()) {
+            (Some(o), Ok(i)) => *o == i,
+            _ => false,
+        };
+        if same_path || same_inode(output, input) {
+            return Err(IoError::SameAsInput {
+                path: output.to_path_buf(),
+            });
+        }
+    }
+    Ok(())
+}
