@@ -12,9 +12,24 @@ fn probe(name: &str, ext: &str) -> PathBuf {
         .join(format!("{name}.{ext}"))
 }
 
+/// Every bundled probe name (each has an `.exr` and an `.hdr`).
+fn bundled_probes() -> Vec<String> {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../assets/probes");
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .expect("assets/probes")
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "exr"))
+        .filter_map(|p| p.file_stem().map(|s| s.to_string_lossy().into_owned()))
+        .collect();
+    names.sort();
+    assert!(names.len() >= 4, "bundled probes: {names:?}");
+    names
+}
+
 #[test]
 fn exr_and_hdr_probes_agree_within_rgbe_precision() {
-    for name in ["apartment", "esplanade", "sunset", "night"] {
+    for name in bundled_probes() {
+        let name = name.as_str();
         let exr = read_image(&probe(name, "exr")).expect("exr reads");
         let hdr = read_image(&probe(name, "hdr")).expect("hdr reads");
         assert_eq!(

@@ -234,10 +234,19 @@ struct Pixels {
 }
 
 impl Pixels {
-    fn new(size: x::Vec2<usize>) -> Pixels {
+    /// Storage for the size `exr` reports, allocated only when it equals the data window our own
+    /// header parse already checked against the limits. A hostile file can make the two parses
+    /// disagree (the fuzzer found one asking for 1.9 TB); then nothing is allocated, every write
+    /// is dropped, and [`read_pixels`] reports the mismatch.
+    fn new(size: x::Vec2<usize>, checked: (usize, usize)) -> Pixels {
+        let data = if (size.width(), size.height()) == checked {
+            vec![Rgb::ZERO; size.area()]
+        } else {
+            Vec::new()
+        };
         Pixels {
             width: size.width(),
-            data: vec![Rgb::ZERO; size.area()],
+            data,
         }
     }
 
@@ -311,6 +320,7 @@ fn decode_layers<'s, L: ReadLayers<'s>>(
 fn read_pixels(
     bytes: &[u8],
     selection: &Selection,
+    checked: (usize, usize),
 ) -> Result<(x::Vec2<usize>, Pixels), DecodeError> {
     let reader = x::read()
         .no_deep_data()
@@ -323,7 +333,7 @@ fn read_pixels(
                 .required(text(g)?)
                 .required(text(b)?)
                 .collect_pixels(
-                    |size, _| Pixels::new(size),
+                    |size, _| Pixels::new(size, checked),
                     |px: &mut Pixels, pos, (r, g, b): (f32, f32, f32)| {
                         px.set(pos, Rgb::new(r, g, b))
                     },
@@ -335,15 +345,35 @@ fn read_pixels(
             let read = reader
                 .required(text(y)?)
                 .collect_pixels(
-                    |size, _| Pixels::new(size),
+                    |size, _| Pixels::new(size, checked),
                     |px: &mut Pixels, pos, (v,): (f32,)| px.set(pos, Rgb::splat(v)),
                 )
                 .first_valid_layer();
             let layer = decode_layers(bytes, &read)?;
-            return Ok((layer.size, layer.channel_data.pixels));
+            return consistent(layer.size, layer.channel_data.pixels, checked);
         }
     };
-    Ok((layer.size, layer.channel_data.pixels))
+    consistent(layer.size, layer.channel_data.pixels, checked)
+}
+
+/// Fails when `exr` read a different image size than our header parse checked.
+fn consistent(
+    size: x::Vec2<usize>,
+    pixels: Pixels,
+    checked: (usize, usize),
+) -> Result<(x::Vec2<usize>, Pixels), DecodeError> {
+    if (size.width(), size.height()) != checked || pixels.data.len() != size.area() {
+        return Err(DecodeError::invalid(format!(
+            "inconsistent header: the selected part's data window is {} x {} but the layer \
+             decoded is {} x {} (a corrupt header, or a multi-part file whose first RGB part is \
+             not the selected one)",
+            checked.0,
+            checked.1,
+            size.width(),
+            size.height()
+        )));
+    }
+    Ok((size, pixels))
 }
 
 /// Copies the data window's pixels into an image the size of the display window.
@@ -397,13 +427,10 @@ pub fn decode(bytes: &[u8], limits: &Limits) -> Result<RawImage, DecodeError> {
         _ => dw,
     };
 
-    let (size, pixels) = catch_unwind(AssertUnwindSafe(|| read_pixels(bytes, &selection)))
+    let checked = (dw.width() as usize, dw.height() as usize);
+    let (size, pixels) = catch_unwind(AssertUnwindSafe(|| read_pixels(bytes, &selection, checked)))
         .map_err(|_| DecodeError::invalid("the OpenEXR decoder failed on inconsistent data"))??;
-    if (size.width() as i64, size.height() as i64) != (dw.width(), dw.height()) {
-        return Err(DecodeError::Unsupported(
-            "multi-part OpenEXR whose first matching part is not the selected one".into(),
-        ));
-    }
+    debug_assert_eq!((size.width(), size.height()), checked);
     let image = place(pixels.data, dw, disp)?;
 
     let code = part.compression.unwrap_or(0);
