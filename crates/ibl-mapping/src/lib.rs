@@ -1,1 +1,28 @@
-//! stub
+//! Environment-map mappings for iblkit: lat-long, angular map, mirror ball, cube maps (crosses
+//! and strip), single and dual fisheye; their exact texel solid angles, total power, rotation and
+//! energy-conserving resampling between any two of them.
+//!
+//! Frame and formulas follow `docs/CONVENTIONS.md` (sections 1-4): world +Y up, -Z forward, +X
+//! right; images row 0 at the top; continuous image coordinates put pixel (i, j)'s centre at
+//! `(i + 0.5, j + 0.5)`. Modules:
+//!
+//! * [`mapping`]: the [`Mapping`] enum, names, shapes, sizes, per-pixel geometry.
+//! * [`cube`]: GL/KTX cube faces, cross and strip layouts, split/join of faces.
+//! * [`disc`]: angular map, mirror ball and the radial machinery (exact clipped solid angles).
+//! * [`fisheye`]: equidistant single and dual fisheye, the dual's feathered blend.
+//! * [`resample`](mod@resample): area-averaging resampling and rotation (rows in parallel,
+//!   deterministic).
+//! * [`power`](mod@power): `sum L dOmega` per channel.
+
+pub mod cube;
+pub mod disc;
+pub mod fisheye;
+pub mod mapping;
+pub mod power;
+mod projection;
+pub mod resample;
+
+pub use cube::{CUBE_FACE_NAMES, join_cube_faces, split_cube_faces};
+pub use mapping::{CubeLayout, MAPPING_NAMES, Mapping, MappingError};
+pub use power::{power, try_power};
+pub use resample::{resample, rotate};
