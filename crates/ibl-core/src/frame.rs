@@ -34,8 +34,12 @@ pub enum FramePreset {
 
 impl FramePreset {
     /// Every preset, in a stable order.
-    pub const ALL: [FramePreset; 4] =
-        [FramePreset::Gltf, FramePreset::Paper, FramePreset::Threejs, FramePreset::Blender];
+    pub const ALL: [FramePreset; 4] = [
+        FramePreset::Gltf,
+        FramePreset::Paper,
+        FramePreset::Threejs,
+        FramePreset::Blender,
+    ];
 
     /// The preset's name as used on the command line and in files.
     pub fn name(self) -> &'static str {
@@ -49,7 +53,9 @@ impl FramePreset {
 
     /// Looks a preset up by name (case-insensitive).
     pub fn from_name(name: &str) -> Option<FramePreset> {
-        Self::ALL.into_iter().find(|p| p.name().eq_ignore_ascii_case(name))
+        Self::ALL
+            .into_iter()
+            .find(|p| p.name().eq_ignore_ascii_case(name))
     }
 
     /// Matrix taking a vector written in the preset's axes to our world frame.
@@ -123,7 +129,10 @@ mod tests {
     fn presets_are_orthogonal() {
         for p in FramePreset::ALL {
             for m in [p.world_from_preset(), p.world_from_latlong_image()] {
-                assert!((m * m.transpose()).abs_diff_eq(Mat3::IDENTITY, 1e-6), "{p:?}");
+                assert!(
+                    (m * m.transpose()).abs_diff_eq(Mat3::IDENTITY, 1e-6),
+                    "{p:?}"
+                );
             }
             assert_eq!(FramePreset::from_name(p.name()), Some(p));
         }
@@ -131,9 +140,17 @@ mod tests {
 
     #[test]
     fn yaw_moves_forward_to_the_left() {
-        let r = EulerDegrees { yaw_deg: 90.0, ..Default::default() }.world_from_probe();
+        let r = EulerDegrees {
+            yaw_deg: 90.0,
+            ..Default::default()
+        }
+        .world_from_probe();
         assert!((r * Vec3::NEG_Z).abs_diff_eq(Vec3::NEG_X, 1e-6));
-        let r = EulerDegrees { pitch_deg: 90.0, ..Default::default() }.world_from_probe();
+        let r = EulerDegrees {
+            pitch_deg: 90.0,
+            ..Default::default()
+        }
+        .world_from_probe();
         assert!((r * Vec3::NEG_Z).abs_diff_eq(Vec3::Y, 1e-6));
     }
 }

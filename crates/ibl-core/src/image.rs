@@ -45,16 +45,23 @@ impl<T: Clone> Image<T> {
     /// # Panics
     /// If `width * height` overflows; sizes from files must go through [`Image::from_vec`].
     pub fn filled(width: usize, height: usize, value: T) -> Self {
-        let n = width.checked_mul(height).expect("image size overflows usize");
-        Image { width, height, data: vec![value; n] }
+        let n = width
+            .checked_mul(height)
+            .expect("image size overflows usize");
+        Image {
+            width,
+            height,
+            data: vec![value; n],
+        }
     }
 }
 
 impl<T> Image<T> {
     /// Wraps a row-major pixel vector (row 0 first).
     pub fn from_vec(width: usize, height: usize, data: Vec<T>) -> Result<Self, ImageError> {
-        let expected =
-            width.checked_mul(height).ok_or(ImageError::SizeOverflow { width, height })?;
+        let expected = width
+            .checked_mul(height)
+            .ok_or(ImageError::SizeOverflow { width, height })?;
         if data.len() != expected {
             return Err(ImageError::LengthMismatch {
                 width,
@@ -63,7 +70,11 @@ impl<T> Image<T> {
                 actual: data.len(),
             });
         }
-        Ok(Image { width, height, data })
+        Ok(Image {
+            width,
+            height,
+            data,
+        })
     }
 
     /// Builds an image by calling `f(x, y)` for every pixel, in parallel over rows.
@@ -76,7 +87,11 @@ impl<T> Image<T> {
             .flat_map_iter(|y| (0..width).map(move |x| (x, y)))
             .map(|(x, y)| f(x, y))
             .collect();
-        Image { width, height, data }
+        Image {
+            width,
+            height,
+            data,
+        }
     }
 
     /// Width in pixels.
@@ -104,7 +119,10 @@ impl<T> Image<T> {
     /// # Panics
     /// If the coordinates are outside the image.
     pub fn get(&self, x: usize, y: usize) -> &T {
-        assert!(x < self.width && y < self.height, "pixel ({x}, {y}) outside image");
+        assert!(
+            x < self.width && y < self.height,
+            "pixel ({x}, {y}) outside image"
+        );
         &self.data[y * self.width + x]
     }
 
@@ -113,7 +131,10 @@ impl<T> Image<T> {
     /// # Panics
     /// If the coordinates are outside the image.
     pub fn get_mut(&mut self, x: usize, y: usize) -> &mut T {
-        assert!(x < self.width && y < self.height, "pixel ({x}, {y}) outside image");
+        assert!(
+            x < self.width && y < self.height,
+            "pixel ({x}, {y}) outside image"
+        );
         &mut self.data[y * self.width + x]
     }
 
@@ -144,7 +165,11 @@ impl<T> Image<T> {
 
     /// A new image of the same size with `f` applied to every pixel.
     pub fn map<U>(&self, f: impl Fn(&T) -> U) -> Image<U> {
-        Image { width: self.width, height: self.height, data: self.data.iter().map(f).collect() }
+        Image {
+            width: self.width,
+            height: self.height,
+            data: self.data.iter().map(f).collect(),
+        }
     }
 
     /// The image flipped top to bottom (for formats stored bottom-up).

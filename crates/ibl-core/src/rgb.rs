@@ -52,7 +52,9 @@ impl Rgb {
 
     /// Rec. 709 luminance of a linear triple (same unit as the channels).
     pub fn luminance(self) -> f32 {
-        LUMINANCE_WEIGHTS[0] * self.r + LUMINANCE_WEIGHTS[1] * self.g + LUMINANCE_WEIGHTS[2] * self.b
+        LUMINANCE_WEIGHTS[0] * self.r
+            + LUMINANCE_WEIGHTS[1] * self.g
+            + LUMINANCE_WEIGHTS[2] * self.b
     }
 
     /// Largest of the three channels.
@@ -143,7 +145,11 @@ pub struct Rgb64 {
 
 impl Rgb64 {
     /// Zero in every channel.
-    pub const ZERO: Rgb64 = Rgb64 { r: 0.0, g: 0.0, b: 0.0 };
+    pub const ZERO: Rgb64 = Rgb64 {
+        r: 0.0,
+        g: 0.0,
+        b: 0.0,
+    };
 
     /// Adds `c * w` (a radiance times a weight such as a solid angle).
     pub fn add_weighted(&mut self, c: Rgb, w: f64) {
@@ -168,7 +174,11 @@ impl Rgb64 {
 impl Add for Rgb64 {
     type Output = Rgb64;
     fn add(self, o: Rgb64) -> Rgb64 {
-        Rgb64 { r: self.r + o.r, g: self.g + o.g, b: self.b + o.b }
+        Rgb64 {
+            r: self.r + o.r,
+            g: self.g + o.g,
+            b: self.b + o.b,
+        }
     }
 }
 

@@ -24,7 +24,11 @@ impl SummedAreaTable {
                 table[(y + 1) * stride + x + 1] = table[y * stride + x + 1] + row_sum;
             }
         }
-        SummedAreaTable { width, height, table }
+        SummedAreaTable {
+            width,
+            height,
+            table,
+        }
     }
 
     /// Width of the summed image.
