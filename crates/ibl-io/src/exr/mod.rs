@@ -189,7 +189,12 @@ fn check_part(part: &Part, deep: bool, limits: &Limits) -> Result<(u64, u64), De
     Ok((w as u64, h as u64))
 }
 
-/// Rejects headers that describe more data than the file could possibly hold.
+/// Largest uncompressed pixel block (one chunk) we let `exr` allocate: 256 MiB, far above any
+/// real file (a 65536-wide float RGBA scanline block of 32 lines is 32 MiB).
+const MAX_BLOCK_BYTES: u128 = 256 << 20;
+
+/// Rejects headers that describe more data than the file could possibly hold, or blocks larger
+/// than [`MAX_BLOCK_BYTES`].
 fn check_file_size(
     header: &FileHeader,
     sizes: &[(u64, u64)],
@@ -208,6 +213,21 @@ fn check_file_size(
             None => u128::from(h.div_ceil(lines_per_chunk(code))),
         };
         let bytes_per_pixel: u64 = part.channels.iter().filter_map(|c| c.sample_bytes()).sum();
+        // `exr` allocates up to one uncompressed block per chunk before checking the chunk's
+        // size field against the file, so the block size itself must be bounded (hundreds of
+        // channels make a block of a narrow image gigabytes; the fuzzer found one).
+        let block_pixels = match part.tiles.filter(|_| tiled) {
+            Some((tw, th)) => u128::from(tw) * u128::from(th),
+            None => u128::from(w) * u128::from(lines_per_chunk(code)),
+        };
+        let block_bytes = block_pixels * u128::from(bytes_per_pixel);
+        if block_bytes > MAX_BLOCK_BYTES {
+            return Err(DecodeError::Limits(format!(
+                "one pixel block would hold {block_bytes} bytes ({} channels, {bytes_per_pixel} \
+                 bytes per pixel), over the {MAX_BLOCK_BYTES}-byte limit",
+                part.channels.len()
+            )));
+        }
         let ratio: u128 = match code {
             0 => 1,
             1 => 64,
@@ -272,6 +292,31 @@ fn text(name: &str) -> Result<x::Text, DecodeError> {
         .ok_or_else(|| DecodeError::invalid(format!("channel name {name:?} is not Latin-1")))
 }
 
+/// Bounds what `exr` will allocate, judged on the headers exactly as `exr` parsed them (a hostile
+/// file with repeated attributes can make our own header parse and `exr`'s disagree, so the
+/// checks in [`check_file_size`] are repeated here on `exr`'s view): each uncompressed block at
+/// most [`MAX_BLOCK_BYTES`], and an offset table that fits in the file.
+fn check_parsed_headers(
+    headers: &[::exr::meta::header::Header],
+    len: usize,
+) -> Result<(), DecodeError> {
+    for h in headers {
+        let block = h.max_block_byte_size() as u128;
+        if block > MAX_BLOCK_BYTES {
+            return Err(DecodeError::Limits(format!(
+                "one pixel block would hold {block} bytes, over the {MAX_BLOCK_BYTES}-byte limit"
+            )));
+        }
+        if (h.chunk_count as u128) * 8 > len as u128 {
+            return Err(DecodeError::Limits(format!(
+                "the header lists {} chunks, more than a {len}-byte file can index",
+                h.chunk_count
+            )));
+        }
+    }
+    Ok(())
+}
+
 /// Compressed chunks decompressed together: bounds the extra memory to that many blocks.
 const CHUNK_BATCH: usize = 64;
 
@@ -284,6 +329,7 @@ fn decode_layers<'s, L: ReadLayers<'s>>(
     read_layers: &'s L,
 ) -> Result<L::Layers, DecodeError> {
     let chunks = ::exr::block::read(Cursor::new(bytes), false).map_err(from_exr_error)?;
+    check_parsed_headers(chunks.headers(), bytes.len())?;
     let mut layers = read_layers
         .create_layers_reader(chunks.headers())
         .map_err(from_exr_error)?;
