@@ -45,7 +45,7 @@ use glam::DVec3;
 use ibl_core::{Image, Rgb};
 
 use crate::mapping::{CubeLayout, Mapping, MappingError};
-use crate::projection::Taps;
+use crate::projection::{Taps, bilinear_corners};
 
 /// File-name suffixes of the six faces, in face order `+X, -X, +Y, -Y, +Z, -Z`.
 pub const CUBE_FACE_NAMES: [&str; 6] = ["px", "nx", "py", "ny", "pz", "nz"];
@@ -230,19 +230,10 @@ impl CubeImage {
     pub(crate) fn taps(&self, d: DVec3) -> Taps {
         let (face, sc, tc) = dir_face(d);
         let s = self.size as f64;
-        let fx = ((sc + 1.0) * 0.5 * s - 0.5).clamp(0.0, s - 1.0);
-        let fy = ((tc + 1.0) * 0.5 * s - 0.5).clamp(0.0, s - 1.0);
-        let (i0, j0) = (fx.floor() as usize, fy.floor() as usize);
-        let (tx, ty) = (fx - i0 as f64, fy - j0 as f64);
-        let i1 = (i0 + 1).min(self.size - 1);
-        let j1 = (j0 + 1).min(self.size - 1);
+        let fx = (sc + 1.0) * 0.5 * s - 0.5;
+        let fy = (tc + 1.0) * 0.5 * s - 0.5;
         let mut taps = Taps::default();
-        for (i, j, w) in [
-            (i0, j0, (1.0 - tx) * (1.0 - ty)),
-            (i1, j0, tx * (1.0 - ty)),
-            (i0, j1, (1.0 - tx) * ty),
-            (i1, j1, tx * ty),
-        ] {
+        for (i, j, w) in bilinear_corners(fx, fy, self.size, self.size) {
             taps.push(self.texel_index(face, i, j), w);
         }
         taps

@@ -36,7 +36,7 @@ use std::f64::consts::{PI, TAU};
 
 use glam::DVec3;
 
-use crate::projection::Taps;
+use crate::projection::{Taps, bilinear_corners};
 
 /// The radial law of a disc mapping.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -263,19 +263,8 @@ impl Disc {
     /// overlap the disc (weights renormalised to sum to 1), so nothing outside the disc or in
     /// the other cell bleeds in. Indices are into the whole image with `stride` pixels per row.
     pub(crate) fn taps(&self, stride: usize, x: f64, y: f64) -> Taps {
-        let fx = (x - self.x0 as f64 - 0.5).clamp(0.0, (self.cw - 1) as f64);
-        let fy = (y - 0.5).clamp(0.0, (self.h - 1) as f64);
-        let (i0, j0) = (fx.floor() as usize, fy.floor() as usize);
-        let (tx, ty) = (fx - i0 as f64, fy - j0 as f64);
-        let i1 = (i0 + 1).min(self.cw - 1);
-        let j1 = (j0 + 1).min(self.h - 1);
         let mut taps = Taps::default();
-        for (i, j, w) in [
-            (i0, j0, (1.0 - tx) * (1.0 - ty)),
-            (i1, j0, tx * (1.0 - ty)),
-            (i0, j1, (1.0 - tx) * ty),
-            (i1, j1, tx * ty),
-        ] {
+        for (i, j, w) in bilinear_corners(x - self.x0 as f64 - 0.5, y - 0.5, self.cw, self.h) {
             if w > 0.0 && self.texel_in_disc(i, j) {
                 taps.push(j * stride + self.x0 + i, w);
             }

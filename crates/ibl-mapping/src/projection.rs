@@ -277,6 +277,28 @@ fn latlong_taps(ll: &LatLong, d: DVec3) -> Taps {
     taps
 }
 
+/// The four bilinear corners `(column, row, weight)` of continuous texel coordinates `(fx, fy)`
+/// (texel centres at integers), clamped to a `width` x `height` grid.
+pub(crate) fn bilinear_corners(
+    fx: f64,
+    fy: f64,
+    width: usize,
+    height: usize,
+) -> [(usize, usize, f64); 4] {
+    let fx = fx.clamp(0.0, width.saturating_sub(1) as f64);
+    let fy = fy.clamp(0.0, height.saturating_sub(1) as f64);
+    let (i0, j0) = (fx.floor() as usize, fy.floor() as usize);
+    let (tx, ty) = (fx - i0 as f64, fy - j0 as f64);
+    let i1 = (i0 + 1).min(width.saturating_sub(1));
+    let j1 = (j0 + 1).min(height.saturating_sub(1));
+    [
+        (i0, j0, (1.0 - tx) * (1.0 - ty)),
+        (i1, j0, tx * (1.0 - ty)),
+        (i0, j1, (1.0 - tx) * ty),
+        (i1, j1, tx * ty),
+    ]
+}
+
 /// Up to eight (pixel index, weight) pairs: a bilinear look-up, or two blended ones.
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct Taps {
