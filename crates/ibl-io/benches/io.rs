@@ -52,6 +52,26 @@ fn benches(c: &mut Criterion) {
     group.bench_function("hdr_rle_decode", |b| {
         b.iter(|| hdr::decode(black_box(&hdr_bytes), &limits).map(|r| r.image.len()))
     });
+    // Baseline: the `image` crate's Radiance codec on the same pixels and bytes.
+    let pixels: Vec<image::Rgb<f32>> = image
+        .pixels()
+        .iter()
+        .map(|p| image::Rgb([p.r, p.g, p.b]))
+        .collect();
+    group.bench_function("baseline_image_crate_hdr_encode", |b| {
+        b.iter(|| {
+            let mut out = Vec::new();
+            image::codecs::hdr::HdrEncoder::new(&mut out)
+                .encode(black_box(&pixels), W, H)
+                .map(|()| out.len())
+        })
+    });
+    group.bench_function("baseline_image_crate_hdr_decode", |b| {
+        b.iter(|| {
+            image::load_from_memory_with_format(black_box(&hdr_bytes), image::ImageFormat::Hdr)
+                .map(|i| i.width())
+        })
+    });
 
     for (name, precision) in [("float", ExrPrecision::Float), ("half", ExrPrecision::Half)] {
         let options = ExrOptions {
@@ -66,6 +86,10 @@ fn benches(c: &mut Criterion) {
         });
         group.bench_function(format!("exr_{name}_zip_decode"), |b| {
             b.iter(|| exr::decode(black_box(&bytes), &limits).map(|r| r.image.len()))
+        });
+        // Baseline: the `exr` crate's own RGBA reader (its default, multi-threaded).
+        group.bench_function(format!("baseline_exr_crate_{name}_zip_decode"), |b| {
+            b.iter(|| stock_exr::read_first_rgba_layer_from_file_bytes(black_box(&bytes)))
         });
         println!("exr {name} zip: {} bytes", bytes.len());
     }
@@ -86,6 +110,30 @@ fn benches(c: &mut Criterion) {
         hdr_bytes.len(),
         pfm_bytes.len()
     );
+}
+
+/// The `exr` crate's stock reader over bytes in memory: RGBA as f32, all cores.
+mod stock_exr {
+    use ::exr::prelude::*;
+
+    /// Decodes the first RGBA layer; returns its pixel count.
+    pub fn read_first_rgba_layer_from_file_bytes(bytes: &[u8]) -> usize {
+        read()
+            .no_deep_data()
+            .largest_resolution_level()
+            .rgba_channels(
+                |size, _| vec![[0.0f32; 3]; size.0 * size.1],
+                |px: &mut Vec<[f32; 3]>, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+                    let w = 2048;
+                    px[pos.1 * w + pos.0] = [r, g, b];
+                },
+            )
+            .first_valid_layer()
+            .all_attributes()
+            .from_buffered(std::io::Cursor::new(bytes))
+            .map(|img| img.layer_data.channel_data.pixels.len())
+            .unwrap_or(0)
+    }
 }
 
 fn main() {
