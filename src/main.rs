@@ -26,6 +26,7 @@ Examples:
   ibl info assets/probes/esplanade.exr       statistics, power and brightest direction
   ibl convert probe.hdr cube.exr --to cube-hcross
   ibl preview probe.exr probe.png --tonemap aces
+  ibl lights probe.exr -n 16 -o lights.json
 
 Exit codes: 0 success, 1 internal failure, 2 bad input or arguments.";
 
@@ -35,6 +36,10 @@ enum Command {
     Info(cmd::info::InfoArgs),
     /// Convert between file formats and environment-map mappings, with rotation.
     Convert(cmd::convert::ConvertArgs),
+    /// Ground-truth irradiance of a lat-long probe on Fibonacci normals, as CSV.
+    Irradiance(cmd::irradiance::IrradianceArgs),
+    /// Approximate a lat-long probe by N directional lights and write them as JSON.
+    Lights(cmd::lights::LightsArgs),
     /// Write a tone-mapped 8-bit preview (PNG or JPEG) of an HDR image.
     Preview(cmd::preview::PreviewArgs),
     /// Run the main job on the bundled probes and write everything to a folder.
@@ -57,6 +62,8 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Info(args) => cmd::info::run(&args),
         Command::Convert(args) => cmd::convert::run(&args),
+        Command::Irradiance(args) => cmd::irradiance::run(&args),
+        Command::Lights(args) => cmd::lights::run(&args),
         Command::Preview(args) => cmd::preview::run(&args),
         Command::Demo(args) => cmd::demo::run(&args),
     };

@@ -234,7 +234,7 @@ fn missing_files_and_bad_arguments_exit_2() {
 
 #[test]
 fn every_help_has_examples() {
-    for cmd in ["info", "convert", "preview", "demo"] {
+    for cmd in ["info", "convert", "preview", "demo", "lights", "irradiance"] {
         let out = ibl(&[cmd, "--help"]);
         assert!(out.status.success());
         assert!(
@@ -324,4 +324,128 @@ fn demo_writes_every_mapping_and_an_index() {
         }
     }
     assert!(Path::new(&out_dir.join("esplanade/cube-faces_px.exr")).exists());
+}
+
+#[test]
+fn lights_writes_the_json_light_set_and_conserves_power() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("sky.json");
+    let o = ibl(&[
+        "lights",
+        &probe("sky.exr"),
+        "-n",
+        "16",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&std::fs::read(&out).unwrap()).unwrap();
+    assert_eq!(v["format"], "iblkit.lights/1");
+    assert_eq!(v["frame"], "gltf");
+    assert_eq!(v["method"]["name"], "median-cut");
+    assert_eq!(v["probe"]["width"], 512);
+    assert_eq!(v["probe"]["sha256"].as_str().unwrap().len(), 64);
+    let lights = v["lights"].as_array().unwrap();
+    assert_eq!(lights.len(), 16);
+    let info = ibl(&["info", &probe("sky.exr"), "--json"]);
+    let info: serde_json::Value = serde_json::from_slice(&info.stdout).unwrap();
+    for c in 0..3 {
+        let sum: f64 = lights
+            .iter()
+            .map(|l| l["irradiance"][c].as_f64().unwrap())
+            .sum();
+        let power = info["power"][c].as_f64().unwrap();
+        assert!(
+            (sum - power).abs() / power < 1e-6,
+            "channel {c}: {sum} vs {power}"
+        );
+    }
+    // The same set in Blender's axes: ours = (x, z, -y), so blender = (x, -z, y).
+    let out_b = dir.path().join("sky-blender.json");
+    let o = ibl(&[
+        "lights",
+        &probe("sky.exr"),
+        "-n",
+        "16",
+        "-o",
+        out_b.to_str().unwrap(),
+        "--frame",
+        "blender",
+    ]);
+    assert!(o.status.success());
+    let b: serde_json::Value = serde_json::from_slice(&std::fs::read(&out_b).unwrap()).unwrap();
+    let (d, db) = (&lights[3]["direction"], &b["lights"][3]["direction"]);
+    let f = |x: &serde_json::Value| x.as_f64().unwrap();
+    assert!((f(&db[0]) - f(&d[0])).abs() < 1e-12);
+    assert!((f(&db[1]) + f(&d[2])).abs() < 1e-12);
+    assert!((f(&db[2]) - f(&d[1])).abs() < 1e-12);
+}
+
+#[test]
+fn lights_rejects_counts_median_cut_cannot_make() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("x.json");
+    let o = ibl(&[
+        "lights",
+        &probe("sky.exr"),
+        "-n",
+        "10",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("power of two"));
+    let o = ibl(&[
+        "lights",
+        &probe("sky.exr"),
+        "-n",
+        "8",
+        "-o",
+        dir.path().join("x.txt").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(!out.exists());
+}
+
+#[test]
+fn irradiance_csv_is_the_ground_truth() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("e.csv");
+    let o = ibl(&[
+        "irradiance",
+        &probe("night.exr"),
+        "--normals",
+        "500",
+        "--csv",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("nx,ny,nz,r,g,b"));
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 500);
+    // Row k holds Fibonacci normal k of CONVENTIONS section 5.
+    let k = 123.0f64;
+    let y = 1.0 - (2.0 * k + 1.0) / 500.0;
+    let a = k * std::f64::consts::PI * (3.0 - 5.0f64.sqrt());
+    let r = (1.0 - y * y).sqrt();
+    let row = &rows[123];
+    assert!((row[0] - r * a.cos()).abs() < 1e-12 && (row[1] - y).abs() < 1e-12);
+    assert!((row[2] - r * a.sin()).abs() < 1e-12);
+    assert!(
+        rows.iter()
+            .all(|r| r[3..].iter().all(|e| e.is_finite() && *e >= 0.0))
+    );
+    let o = ibl(&[
+        "irradiance",
+        &probe("night.exr"),
+        "--normals",
+        "0",
+        "--csv",
+        csv.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
 }

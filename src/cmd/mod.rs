@@ -3,4 +3,6 @@
 pub mod convert;
 pub mod demo;
 pub mod info;
+pub mod irradiance;
+pub mod lights;
 pub mod preview;

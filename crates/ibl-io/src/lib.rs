@@ -22,6 +22,7 @@ pub mod exr;
 mod format;
 pub mod hdr;
 pub mod ldr;
+pub mod light_file;
 pub mod pfm;
 pub mod sanitize;
 pub mod tonemap;

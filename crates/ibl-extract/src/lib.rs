@@ -1,0 +1,21 @@
+//! Light extraction (Madsen & Laursen 2006): replacing a lat-long light probe by N directional
+//! lights. Each method lives in its own module and returns a [`LightSet`] in the world frame
+//! (CONVENTIONS section 4): per light a direction, an RGB radiance, a solid angle and the
+//! irradiance `I = L A` it gives a surface facing it.
+
+pub mod light_set;
+pub mod median_cut;
+
+pub use light_set::{Light, LightSet, PixelRegion};
+pub use median_cut::median_cut;
+
+/// Why a light set could not be extracted.
+#[derive(Debug, thiserror::Error, PartialEq, Eq)]
+pub enum ExtractError {
+    /// A parameter is out of its range (the message says which and why).
+    #[error("{0}")]
+    Parameter(String),
+    /// The probe is not a usable lat-long map.
+    #[error("{0}")]
+    Invalid(String),
+}
