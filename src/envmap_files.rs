@@ -124,20 +124,15 @@ pub fn load(path: &Path, mapping: Option<MappingArg>) -> anyhow::Result<LoadedEn
 fn load_faces(pattern: &Path) -> anyhow::Result<LoadedEnv> {
     let paths = face_paths(pattern);
     let mut faces = Vec::with_capacity(6);
-    let mut report = SanitizeReport::default();
+    let mut report: Option<SanitizeReport> = None;
     let mut first: Option<(ImageFormat, String)> = None;
     for p in &paths {
         let loaded = ibl_io::read_image(p)?;
-        report.negative_values += loaded.report.negative_values;
-        report.nonfinite_values += loaded.report.nonfinite_values;
-        report.raw_min = Rgb::new(
-            report.raw_min.r.min(loaded.report.raw_min.r),
-            report.raw_min.g.min(loaded.report.raw_min.g),
-            report.raw_min.b.min(loaded.report.raw_min.b),
-        );
+        report = Some(report.map_or(loaded.report, |r| r.merged(loaded.report)));
         first.get_or_insert((loaded.format, loaded.details));
         faces.push(loaded.image);
     }
+    let report = report.ok_or_else(|| anyhow::anyhow!("no cube face read"))?;
     let faces: [Image<Rgb>; 6] = faces
         .try_into()
         .map_err(|_| anyhow::anyhow!("expected six cube faces"))?;

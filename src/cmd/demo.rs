@@ -10,8 +10,9 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use clap::Args;
+use ibl_core::FramePreset;
 use ibl_core::glam::Mat3;
-use ibl_core::{FramePreset, Rgb};
+use ibl_core::rgb::Rgb64;
 use ibl_io::{Display, ToneCurve, WriteOptions};
 use ibl_mapping::{CubeLayout, Mapping};
 use serde::Serialize;
@@ -308,8 +309,13 @@ fn print_summary(out: &Path, results: &[ProbeResult]) {
     );
     for r in results {
         let i = &r.info;
-        let power_lum =
-            Rgb::new(i.power[0] as f32, i.power[1] as f32, i.power[2] as f32).luminance();
+        let [pr, pg, pb] = i.power;
+        let power_lum = Rgb64 {
+            r: pr,
+            g: pg,
+            b: pb,
+        }
+        .luminance();
         let changes: Vec<String> = r
             .mappings
             .iter()

@@ -4,6 +4,7 @@
 use std::path::PathBuf;
 
 use clap::{Args, ValueEnum};
+use ibl_core::rgb::Rgb64;
 use ibl_extract::LightSet;
 use ibl_io::light_file::{
     LIGHTS_FORMAT, LightRecord, LightsFile, MethodRef, ProbeRef, RegionRecord,
@@ -131,8 +132,8 @@ fn print_summary(set: &LightSet, probe_power: &[f64; 3]) {
     );
     let mut order: Vec<usize> = (0..set.lights.len()).collect();
     let lum = |i: &usize| {
-        let e = set.lights[*i].irradiance;
-        0.2126 * e[0] + 0.7152 * e[1] + 0.0722 * e[2]
+        let [r, g, b] = set.lights[*i].irradiance;
+        Rgb64 { r, g, b }.luminance()
     };
     order.sort_by(|a, b| lum(b).total_cmp(&lum(a)));
     println!("strongest lights (world direction, solid angle sr, irradiance I = L A):");

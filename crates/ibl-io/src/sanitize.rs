@@ -41,6 +41,20 @@ impl SanitizeReport {
     pub fn is_clean(&self) -> bool {
         self.clamped_values() == 0
     }
+
+    /// The report of several images read as one (e.g. six cube faces): counts add up, the raw
+    /// minimum is the smaller per channel.
+    pub fn merged(self, other: SanitizeReport) -> SanitizeReport {
+        SanitizeReport {
+            negative_values: self.negative_values + other.negative_values,
+            nonfinite_values: self.nonfinite_values + other.nonfinite_values,
+            raw_min: Rgb::new(
+                self.raw_min.r.min(other.raw_min.r),
+                self.raw_min.g.min(other.raw_min.g),
+                self.raw_min.b.min(other.raw_min.b),
+            ),
+        }
+    }
 }
 
 /// Partial counts for one chunk of pixels; `min` starts at +Inf ("no finite value yet").
@@ -110,6 +124,24 @@ pub fn sanitize(image: &mut Image<Rgb>) -> SanitizeReport {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn merged_reports_add_counts_and_keep_the_smaller_minimum() {
+        let a = SanitizeReport {
+            negative_values: 2,
+            nonfinite_values: 1,
+            raw_min: Rgb::new(0.5, -3.0, 0.25),
+        };
+        let b = SanitizeReport {
+            negative_values: 5,
+            nonfinite_values: 0,
+            raw_min: Rgb::new(0.125, 1.0, 2.0),
+        };
+        let m = a.merged(b);
+        assert_eq!((m.negative_values, m.nonfinite_values), (7, 1));
+        // Two clean positive images keep a positive minimum (not the default's 0).
+        assert_eq!(m.raw_min, Rgb::new(0.125, -3.0, 0.25));
+    }
 
     #[test]
     fn clamps_and_counts_per_channel_value() {
