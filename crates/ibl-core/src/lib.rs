@@ -1,7 +1,7 @@
 //! Core types shared by every iblkit crate: linear RGB radiance, images with row 0 at the top,
 //! unit directions in the world frame (+Y up, -Z forward, +X right: the glTF frame), named frame
-//! presets, the lat-long parameterisation with exact texel solid angles, Fibonacci normals and
-//! summed-area tables.
+//! presets, the lat-long parameterisation with exact texel solid angles, Fibonacci normals,
+//! summed-area tables and the exact irradiance of a lat-long probe.
 //!
 //! This crate does no I/O and knows no file formats; see `docs/CONVENTIONS.md` for every formula.
 
@@ -9,6 +9,7 @@ pub mod direction;
 pub mod fibonacci;
 pub mod frame;
 pub mod image;
+pub mod irradiance;
 pub mod latlong;
 pub mod rgb;
 pub mod summed_area;
@@ -18,6 +19,7 @@ pub use fibonacci::fibonacci_normals;
 pub use frame::{EulerDegrees, FramePreset};
 pub use glam;
 pub use image::Image;
+pub use irradiance::{RowIrradiance, channel_means, irradiance_exact};
 pub use latlong::LatLong;
 pub use rgb::Rgb;
 pub use summed_area::SummedAreaTable;

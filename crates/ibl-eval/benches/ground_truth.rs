@@ -11,7 +11,7 @@ use std::hint::black_box;
 use criterion::{Criterion, criterion_group, criterion_main};
 use ibl_core::glam::DVec3;
 use ibl_core::{Image, LatLong, Rgb, fibonacci_normals};
-use ibl_eval::{FAST_DEFAULT_SIZE, irradiance_exact, irradiance_fast};
+use ibl_eval::{FAST_DEFAULT_SIZE, irradiance_brute_force, irradiance_exact, irradiance_fast};
 
 fn environment(w: usize, h: usize) -> Image<Rgb> {
     let ll = LatLong::new(w, h);
@@ -40,6 +40,9 @@ fn bench(c: &mut Criterion) {
     g.sample_size(10);
     g.bench_function("exact_512x256_20000_normals", |b| {
         b.iter(|| irradiance_exact(black_box(&probe), black_box(&normals)))
+    });
+    g.bench_function("brute_force_512x256_20000_normals", |b| {
+        b.iter(|| irradiance_brute_force(black_box(&probe), black_box(&normals)))
     });
     g.bench_function("fast_64x32_20000_normals", |b| {
         b.iter(|| irradiance_fast(black_box(&probe), black_box(&normals), FAST_DEFAULT_SIZE))

@@ -10,20 +10,20 @@
 //! solid angle of the pixel's row (`LatLong::row_solid_angle`, summing to exactly 4 pi).
 //! Radiance that is negative, NaN or infinite counts as 0.
 //!
-//! Why a brute-force sum: it is the definition, with no approximation besides evaluating the
-//! clamped cosine at pixel centres, so it can judge every other method (spherical harmonics,
-//! median cut, fitted lights). It costs O(M * P) for M normals and P non-black pixels
-//! (20000 x 131072 for a 512 x 256 probe, about 2.6e9 multiply-adds per channel), so it is
-//! written to vectorise: the pixels become a structure of arrays ([`Emitters`]) of f64
-//! directions and weights `w = L * dOmega`, and each pass over them serves a block of
-//! [`NORMAL_BLOCK`] normals at once. Each normal's sum is still a fixed sequential loop over the
-//! pixels, so the result does not depend on the block it lands in nor on the rayon thread count.
+//! Two exact paths compute this same sum. [`irradiance_exact`] (from `ibl_core`, re-exported)
+//! organises it by rows and prefix sums, O(H log W) per normal, and is what [`GroundTruth`] uses.
+//! [`irradiance_brute_force`] is the literal per-pixel loop, O(M * P) for M normals and P
+//! non-black pixels, kept as the reference the row path is tested against (they agree to about
+//! 1e-14) and as its benchmark baseline. It is written to vectorise: the pixels become a
+//! structure of arrays ([`Emitters`]) of f64 directions and weights `w = L * dOmega`, and each
+//! pass over them serves a block of [`NORMAL_BLOCK`] normals at once. Each normal's sum is a
+//! fixed sequential loop, so both paths are bit-identical whatever the rayon thread count.
 //!
 //! [`irradiance_fast`] first reduces the probe to a small lat-long grid of energy-conserving
-//! blocks and then runs the same exact loop (64x fewer emitters on a 512 x 256 probe).
+//! blocks and then runs the brute-force loop over them (64x fewer emitters on a 512 x 256 probe).
 
 use ibl_core::glam::DVec3;
-use ibl_core::{Image, LatLong, Rgb, fibonacci_normals};
+use ibl_core::{Image, LatLong, Rgb, channel_means, fibonacci_normals, irradiance_exact};
 use rayon::prelude::*;
 
 /// Normals served by one pass over the pixels (lanes of the vectorised inner loop). Two f64
@@ -193,15 +193,16 @@ impl Emitters {
     }
 }
 
-/// Exact irradiance of a lat-long probe on every normal:
-/// `E_c(n) = sum_p L_pc * max(0, n . d_p) * dOmega_p` over every pixel p, with pixel-centre
-/// directions and exact row solid angles, accumulated in f64.
+/// The per-pixel brute-force sum `E_c(n) = sum_p L_pc * max(0, n . d_p) * dOmega_p`, with
+/// pixel-centre directions and exact row solid angles, accumulated in f64: the reference that
+/// [`irradiance_exact`] (the same sum organised by rows) is checked against, and its benchmark
+/// baseline.
 ///
 /// Cost O(M * P) for M normals and P non-black pixels (a 512 x 256 probe on 20000 normals is
-/// 2.6e9 multiply-adds per channel: about 2 s on 2 cores with the default x86-64 target, see
+/// 2.6e9 multiply-adds per channel: about 1.7 s on 2 cores with the default x86-64 target, see
 /// the crate's bench).
 /// Data-parallel over normals with rayon; bit-identical whatever the thread count.
-pub fn irradiance_exact(probe: &Image<Rgb>, normals: &[DVec3]) -> Vec<[f64; 3]> {
+pub fn irradiance_brute_force(probe: &Image<Rgb>, normals: &[DVec3]) -> Vec<[f64; 3]> {
     Emitters::from_latlong(probe).irradiance(normals)
 }
 
@@ -231,18 +232,6 @@ pub fn irradiance_fast(
     size: (usize, usize),
 ) -> Vec<[f64; 3]> {
     Emitters::from_latlong_downsampled(probe, size.0, size.1).irradiance(normals)
-}
-
-/// Per-channel mean `mu_c = mean_k E_kc` of a set of irradiance values (zeros when empty).
-pub fn channel_means(values: &[[f64; 3]]) -> [f64; 3] {
-    let mut s = [0.0f64; 3];
-    for v in values {
-        for c in 0..3 {
-            s[c] += v[c];
-        }
-    }
-    let n = values.len().max(1) as f64;
-    [s[0] / n, s[1] / n, s[2] / n]
 }
 
 /// The exact irradiance of a probe on a set of normals, with its channel means.

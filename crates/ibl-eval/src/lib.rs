@@ -11,8 +11,14 @@
 
 pub mod ground_truth;
 pub mod metrics;
+pub mod overlay;
+pub mod plot;
+pub mod report;
+pub mod sphere_image;
+pub mod sweep;
 
 pub use ground_truth::{
-    Emitters, FAST_DEFAULT_SIZE, GroundTruth, channel_means, irradiance_exact, irradiance_fast,
+    Emitters, FAST_DEFAULT_SIZE, GroundTruth, irradiance_brute_force, irradiance_fast,
 };
+pub use ibl_core::{RowIrradiance, channel_means, irradiance_exact};
 pub use metrics::{IrradianceError, max_err_pct, mean_err_pct, rel_max_err_pct, rel_mean_err_pct};

@@ -3,11 +3,21 @@
 //! (CONVENTIONS section 4): per light a direction, an RGB radiance, a solid angle and the
 //! irradiance `I = L A` it gives a surface facing it.
 
+pub mod adaptive_median_cut;
+pub mod irradiance_optimization;
 pub mod light_set;
+pub mod lightgen;
 pub mod median_cut;
+pub mod method;
+pub mod variance_minimization;
 
+pub use adaptive_median_cut::adaptive_median_cut;
+pub use irradiance_optimization::{Fit, FitReport, OptimizationOptions, irradiance_optimization};
 pub use light_set::{Light, LightSet, PixelRegion};
+pub use lightgen::{LightGenOptions, lightgen};
 pub use median_cut::median_cut;
+pub use method::{ExtractOptions, Extraction, Method, extract};
+pub use variance_minimization::variance_minimization;
 
 /// Why a light set could not be extracted.
 #[derive(Debug, thiserror::Error, PartialEq, Eq)]
