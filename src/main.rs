@@ -27,6 +27,7 @@ Examples:
   ibl convert probe.hdr cube.exr --to cube-hcross
   ibl preview probe.exr probe.png --tonemap aces
   ibl lights probe.exr -n 16 -o lights.json
+  ibl eval assets/probes/*.exr --out eval     compare every extraction method (report.md)
 
 Exit codes: 0 success, 1 internal failure, 2 bad input or arguments.";
 
@@ -40,6 +41,8 @@ enum Command {
     Irradiance(cmd::irradiance::IrradianceArgs),
     /// Approximate a lat-long probe by N directional lights and write them as JSON.
     Lights(cmd::lights::LightsArgs),
+    /// Compare the light extraction methods on probes: error vs N, plots, spheres, report.
+    Eval(cmd::eval::EvalArgs),
     /// Write a tone-mapped 8-bit preview (PNG or JPEG) of an HDR image.
     Preview(cmd::preview::PreviewArgs),
     /// Run the main job on the bundled probes and write everything to a folder.
@@ -64,6 +67,7 @@ fn main() -> ExitCode {
         Command::Convert(args) => cmd::convert::run(&args),
         Command::Irradiance(args) => cmd::irradiance::run(&args),
         Command::Lights(args) => cmd::lights::run(&args),
+        Command::Eval(args) => cmd::eval::run(&args),
         Command::Preview(args) => cmd::preview::run(&args),
         Command::Demo(args) => cmd::demo::run(&args),
     };

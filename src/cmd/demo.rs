@@ -1,9 +1,10 @@
 //! `ibl demo`: the main job on the bundled probes, with no arguments needed.
 //!
-//! For now (issue 2) it describes every bundled probe, writes a tone-mapped preview, shows each
-//! probe in every mapping (EXR plus preview), converts each back to lat-long and reports how much
-//! power the round trip kept. Everything lands in one folder with an `index.html` to look at and
-//! a `summary.json` for scripts.
+//! It describes every bundled probe, writes a tone-mapped preview, shows each probe in every
+//! mapping (EXR plus preview), converts each back to lat-long and reports how much power the round
+//! trip kept. Then it runs the comparison of `ibl eval` on the same probes (every extraction
+//! method, N = 1 to 128, 20000 scoring normals) into `eval/`. Everything lands in one folder with
+//! an `index.html` to look at and a `summary.json` for scripts.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -17,7 +18,7 @@ use ibl_io::{Display, ToneCurve, WriteOptions};
 use ibl_mapping::{CubeLayout, Mapping};
 use serde::Serialize;
 
-use crate::cmd::info;
+use crate::cmd::{eval, info};
 use crate::envmap_files::{self, MappingArg};
 use crate::failure::usage;
 use crate::progress;
@@ -37,6 +38,12 @@ pub struct DemoArgs {
     #[arg(long, value_name = "DIR")]
     pub probes: Option<PathBuf>,
 }
+
+/// Light counts of the demo's comparison: the powers of two 1 to 128. `ibl eval` also sweeps 256 by
+/// default; the demo leaves it out because irradiance optimisation alone needs about 35 s per
+/// probe there (release build, 2 cores), three minutes for the five bundled probes, against about
+/// 15 s per probe for all of 1 to 128.
+const DEMO_EVAL_COUNTS: [usize; 8] = [1, 2, 4, 8, 16, 32, 64, 128];
 
 /// The mappings the demo shows each probe in, with their file stems.
 fn demo_mappings() -> Vec<(&'static str, MappingArg)> {
@@ -150,10 +157,28 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
         results.push(result);
     }
     bar.finish_and_clear();
-    write_summary(&args.out, &results)?;
+    let settings = eval::EvalSettings::new(
+        ibl_extract::Method::ALL.to_vec(),
+        DEMO_EVAL_COUNTS.to_vec(),
+        ibl_core::fibonacci::DEFAULT_NORMAL_COUNT,
+        ibl_extract::ExtractOptions::default().seed,
+        None,
+    )?;
+    let report = eval::evaluate(&probes, &settings, &args.out.join(EVAL_DIR))
+        .context("comparing the light extraction methods")?;
+    write_summary(&args.out, &results, &report)?;
     print_summary(&args.out, &results);
+    println!();
+    eval::print_lights_needed(&report);
+    println!(
+        "  {}/{EVAL_DIR}/report.md    the comparison: tables, plots, spheres, overlays",
+        args.out.display()
+    );
     Ok(())
 }
+
+/// Sub-folder of the comparison report.
+const EVAL_DIR: &str = "eval";
 
 fn demo_probe(
     path: &Path,
@@ -250,15 +275,81 @@ fn relative(base: &Path, p: &Path) -> String {
     p.strip_prefix(base).unwrap_or(p).display().to_string()
 }
 
-fn write_summary(out: &Path, results: &[ProbeResult]) -> anyhow::Result<()> {
+/// The comparison section of `index.html`: links, the average plot and the lights-needed table.
+fn eval_html(report: &ibl_eval::Report) -> String {
+    let largest = report.counts.iter().copied().max().unwrap_or(0);
+    let counts: Vec<String> = report.counts.iter().map(usize::to_string).collect();
+    let f = &report.files;
+    let mut html = format!(
+        "<h1 id=eval>Light extraction methods compared</h1><p>Every method at N = {}, scored on {} \
+         Fibonacci normals against the exact irradiance (Madsen &amp; Laursen 2006, section 5): \
+         <a href=\"{EVAL_DIR}/{}\">report.md</a> &middot; <a href=\"{EVAL_DIR}/{}\">report.json</a> \
+         &middot; <a href=\"{EVAL_DIR}/{}\">report.csv</a>. Fitted methods: {}.</p>",
+        counts.join(", "),
+        report.normals,
+        f.markdown,
+        f.json,
+        f.csv,
+        report.fit_normals_note
+    );
+    html.push_str(
+        "<table><tr><th>lights needed (average)</th><th>mean_err &le; 1 %</th>\
+         <th>mean_err &le; 5 %</th><th>max_err &le; 1 %</th><th>max_err &le; 5 %</th></tr>",
+    );
+    for x in ibl_eval::LightsNeeded::average(report) {
+        let [a, b, c, d] = x.cells(largest).map(|c| c.replace('>', "&gt;"));
+        let _ = write!(
+            html,
+            "<tr><td>{}</td><td>{a}</td><td>{b}</td><td>{c}</td><td>{d}</td></tr>",
+            x.method
+        );
+    }
+    html.push_str("</table>");
+    for p in &f.plots {
+        let _ = write!(
+            html,
+            "<figure><a href=\"{EVAL_DIR}/{svg}\"><img class=wide src=\"{EVAL_DIR}/{png}\"></a>\
+             <figcaption>{}</figcaption></figure>",
+            p.probe.as_deref().unwrap_or("average over the probes"),
+            svg = p.svg,
+            png = p.png
+        );
+    }
+    for x in &f.figures {
+        for (what, path) in [("spheres", &x.sphere), ("overlay", &x.overlay)] {
+            if let Some(path) = path {
+                let _ = write!(
+                    html,
+                    "<figure><a href=\"{EVAL_DIR}/{path}\"><img src=\"{EVAL_DIR}/{path}\"></a>\
+                     <figcaption>{} {} N={} {what}</figcaption></figure>",
+                    x.probe, x.method, x.n
+                );
+            }
+        }
+    }
+    html
+}
+
+fn write_summary(
+    out: &Path,
+    results: &[ProbeResult],
+    report: &ibl_eval::Report,
+) -> anyhow::Result<()> {
     let json = serde_json::to_string_pretty(results)?;
     std::fs::write(out.join("summary.json"), json)
         .with_context(|| format!("{}: cannot write summary.json", out.display()))?;
     let mut html = String::from(
         "<!doctype html><meta charset=utf-8><title>iblkit demo</title>\
          <style>body{font-family:sans-serif;background:#222;color:#ddd}img{max-height:220px;margin:4px;border:1px solid #444}\
-         figure{display:inline-block;margin:4px}figcaption{font-size:12px}td,th{padding:2px 8px;text-align:right}</style>\
+         figure{display:inline-block;margin:4px}figcaption{font-size:12px}td,th{padding:2px 8px;text-align:right}\
+         img.wide{max-height:none;width:640px}a{color:#9cf}</style>\
          <h1>iblkit demo</h1>",
+    );
+    let _ = write!(
+        html,
+        "<p>Every probe in every mapping below; then <a href=\"#eval\">the light extraction \
+         methods compared</a> (<a href=\"{EVAL_DIR}/{}\">report.md</a>).</p>",
+        report.files.markdown
     );
     for r in results {
         let i = &r.info;
@@ -297,6 +388,7 @@ fn write_summary(out: &Path, results: &[ProbeResult]) -> anyhow::Result<()> {
             );
         }
     }
+    html.push_str(&eval_html(report));
     std::fs::write(out.join("index.html"), html)
         .with_context(|| format!("{}: cannot write index.html", out.display()))?;
     Ok(())

@@ -5,7 +5,15 @@
 //!   lat-long probe on a set of normals (normally 20000 Fibonacci normals), plus a fast,
 //!   energy-conserving approximation of it for interactive use;
 //! * [`metrics`]: the error of an approximation against that ground truth (`mean_err%`,
-//!   `max_err%`, and the per-normal relative `rel_mean%`, `rel_max%`).
+//!   `max_err%`, and the per-normal relative `rel_mean%`, `rel_max%`);
+//! * [`mod@sweep`]: the comparison of section 5: every extraction method at every light count N on
+//!   every probe, timed and scored, as the serde data of `report.json` (`iblkit.eval/1`);
+//! * [`report`]: that report as CSV and as a markdown summary (lights needed for 1 % and 5 %);
+//! * [`plot`]: error-vs-N charts (the paper's Figure 6) as SVG and RGB images;
+//! * [`sphere_image`]: irradiance spheres and error maps (the paper's Figure 4);
+//! * [`overlay`]: light sets drawn over their probe.
+//!
+//! Nothing here reads or writes files: outputs are strings and 8-bit images in memory.
 //!
 //! Everything is f64 and deterministic: results are bit-identical whatever the rayon thread count.
 
@@ -22,3 +30,9 @@ pub use ground_truth::{
 };
 pub use ibl_core::{RowIrradiance, channel_means, irradiance_exact};
 pub use metrics::{IrradianceError, max_err_pct, mean_err_pct, rel_max_err_pct, rel_mean_err_pct};
+pub use plot::{ErrorChart, PLOT_SIZE, PlotError, render_png, render_svg};
+pub use report::{FigureFiles, LightsNeeded, PlotFiles, ReportFiles};
+pub use sphere_image::{SphereField, SphereFigure};
+pub use sweep::{
+    ProbeInput, REPORT_FORMAT, Report, Row, Status, Sweep, SweepOptions, SweepProgress, sweep,
+};

@@ -4,11 +4,14 @@
 //! irradiance `I = L A` it gives a surface facing it.
 
 pub mod adaptive_median_cut;
+mod cholesky;
 pub mod irradiance_optimization;
 pub mod light_set;
 pub mod lightgen;
 pub mod median_cut;
 pub mod method;
+pub mod nnls;
+mod region_stats;
 pub mod variance_minimization;
 
 pub use adaptive_median_cut::adaptive_median_cut;
@@ -17,6 +20,7 @@ pub use light_set::{Light, LightSet, PixelRegion};
 pub use lightgen::{LightGenOptions, lightgen};
 pub use median_cut::median_cut;
 pub use method::{ExtractOptions, Extraction, Method, extract};
+pub use nnls::nnls_gram;
 pub use variance_minimization::variance_minimization;
 
 /// Why a light set could not be extracted.

@@ -144,11 +144,8 @@ pub fn extract(
             crate::lightgen(probe, n, &o)?
         }
         Method::IrradianceOptimization => {
-            let o = crate::OptimizationOptions {
-                seed: options.seed,
-                ..Default::default()
-            };
-            let fit = crate::irradiance_optimization(probe, n, &o)?;
+            let fit =
+                crate::irradiance_optimization(probe, n, &crate::OptimizationOptions::default())?;
             parameters.extend(fit.report.parameters());
             fit.set
         }

@@ -22,6 +22,7 @@ pub mod exr;
 mod format;
 pub mod hdr;
 pub mod ldr;
+pub mod light_export;
 pub mod light_file;
 pub mod pfm;
 pub mod sanitize;
@@ -35,6 +36,7 @@ use ibl_core::{Image, Rgb};
 pub use error::{DecodeError, EncodeError, IoError};
 pub use exr::{ExrCompression, ExrOptions, ExrPrecision};
 pub use format::{ImageFormat, Limits, RawImage};
+pub use light_export::{ExportError, ExportOptions, LightFormat, write_light_file};
 pub use sanitize::{SanitizeReport, sanitize};
 pub use tonemap::{Display, ToneCurve};
 
