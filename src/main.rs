@@ -39,7 +39,7 @@ enum Command {
     Convert(cmd::convert::ConvertArgs),
     /// Ground-truth irradiance of a lat-long probe on Fibonacci normals, as CSV.
     Irradiance(cmd::irradiance::IrradianceArgs),
-    /// Approximate a lat-long probe by N directional lights and write them as JSON.
+    /// Approximate a lat-long probe by N directional lights; write JSON, glTF, Mitsuba or pbrt.
     Lights(cmd::lights::LightsArgs),
     /// Compare the light extraction methods on probes: error vs N, plots, spheres, report.
     Eval(cmd::eval::EvalArgs),

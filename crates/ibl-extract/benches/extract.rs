@@ -1,7 +1,8 @@
 //! Light extraction from a bundled 512 x 256 probe (`assets/probes/sky.exr`, a hard sun in a blue
 //! sky), read before timing: median cut and adaptive median cut (whole run, summed-area tables
-//! included) for N up to 256, variance minimisation, and LightGen-style clustering with its
-//! default 4 restarts.
+//! included) for N up to 256, variance minimisation, LightGen-style clustering with its
+//! default 4 restarts, and irradiance optimisation (whole run: fitting-normal ground truth,
+//! continuation from one light, final fit) at N = 16 and 64.
 //!
 //! Run: `cargo bench -p ibl-extract --bench extract -- --warm-up-time 1 --measurement-time 3`.
 
@@ -13,7 +14,8 @@ use std::path::PathBuf;
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use ibl_core::{Image, Rgb};
 use ibl_extract::{
-    LightGenOptions, adaptive_median_cut, lightgen, median_cut, variance_minimization,
+    LightGenOptions, OptimizationOptions, adaptive_median_cut, irradiance_optimization, lightgen,
+    median_cut, variance_minimization,
 };
 
 fn probe() -> Image<Rgb> {
@@ -51,6 +53,16 @@ fn bench(c: &mut Criterion) {
     for n in [16usize, 64, 256] {
         g.bench_with_input(BenchmarkId::from_parameter(n), &n, |b, &n| {
             b.iter(|| lightgen(black_box(&probe), n, &LightGenOptions::default()))
+        });
+    }
+    g.finish();
+    let mut g = c.benchmark_group("irradiance_optimization_512x256");
+    g.sample_size(10);
+    for n in [16usize, 64] {
+        g.bench_with_input(BenchmarkId::from_parameter(n), &n, |b, &n| {
+            b.iter(|| {
+                irradiance_optimization(black_box(&probe), n, &OptimizationOptions::default())
+            })
         });
     }
     g.finish();
