@@ -2,7 +2,7 @@
 //!
 //! Median cut makes only powers of two (the paper's algorithm); every other method takes any
 //! N >= 1. The fitted method (irradiance optimisation) fits on its own normals, never on the
-//! 20000 Fibonacci normals that `ibl-eval` scores on (see [`crate::irradiance_optimization`]).
+//! 20000 Fibonacci normals that `ibl-eval` scores on (see the [`crate::irradiance_optimization`](mod@crate::irradiance_optimization) module).
 
 use std::collections::BTreeMap;
 use std::fmt;
@@ -15,15 +15,15 @@ use crate::{ExtractError, LightSet};
 /// A light-extraction method.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Method {
-    /// Median cut (Debevec 2005), 2^K lights: [`crate::median_cut`].
+    /// Median cut (Debevec 2005), 2^K lights: [`crate::median_cut()`].
     MedianCut,
-    /// Median cut with any N: [`crate::adaptive_median_cut`].
+    /// Median cut with any N: [`crate::adaptive_median_cut()`].
     AdaptiveMedianCut,
-    /// LightGen-style clustering (Cohen & Debevec 2001): [`crate::lightgen`].
+    /// LightGen-style clustering (Cohen & Debevec 2001): [`crate::lightgen()`].
     LightGen,
-    /// Variance minimisation (Viriyothai & Debevec 2009): [`crate::variance_minimization`].
+    /// Variance minimisation (Viriyothai & Debevec 2009): [`crate::variance_minimization()`].
     VarianceMinimization,
-    /// Irradiance optimisation (Madsen et al. 2003): [`crate::irradiance_optimization`].
+    /// Irradiance optimisation (Madsen et al. 2003): [`crate::irradiance_optimization()`].
     IrradianceOptimization,
 }
 
