@@ -2,31 +2,11 @@
 //! and the hostile-input corpus in `tests/hostile/` (every case must end in a clear error naming
 //! the file and exit code 2, or load with its invalid values counted; never a panic).
 
+mod common;
+
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-fn ibl(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_ibl"))
-        .args(args)
-        .output()
-        .expect("run ibl")
-}
-
-fn repo() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn probe(name: &str) -> String {
-    repo()
-        .join("assets/probes")
-        .join(name)
-        .display()
-        .to_string()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
+use common::{ibl, probe, repo, stderr};
 
 #[test]
 fn info_json_has_every_field_on_every_bundled_probe() {

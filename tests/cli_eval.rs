@@ -3,27 +3,12 @@
 
 #![allow(clippy::unwrap_used)] // tests may panic
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
-fn ibl(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_ibl"))
-        .args(args)
-        .output()
-        .expect("run ibl")
-}
+use std::path::Path;
+use std::process::Output;
 
-fn probe(name: &str) -> String {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("assets/probes")
-        .join(name)
-        .display()
-        .to_string()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
+use common::{ibl, probe, stderr};
 
 fn eval_sky(out: &Path, extra: &[&str]) -> Output {
     let sky = probe("sky.exr");

@@ -3,29 +3,13 @@
 //! the `--json` summary, and exit code 2 for bad flags, unknown extensions, counts median cut
 //! cannot make and outputs that name the input (which must stay untouched).
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
+
+use std::path::Path;
+
+use common::{ibl, probe, stderr};
 
 use serde_json::Value;
-
-fn ibl(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_ibl"))
-        .args(args)
-        .output()
-        .expect("run ibl")
-}
-
-fn probe(name: &str) -> String {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("assets/probes")
-        .join(name)
-        .display()
-        .to_string()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
 
 fn s(p: &Path) -> String {
     p.display().to_string()
