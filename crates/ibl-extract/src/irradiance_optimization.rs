@@ -70,6 +70,9 @@ pub const MAX_LIGHTS: usize = 1024;
 /// What the fit is scored against, in words for reports: the fit never sees the scoring normals.
 pub const FIT_NORMALS_NOTE: &str = "fitted on 4096 Fibonacci normals turned by 0.5 rad about the axis (1,1,1); scored on the 20000 Fibonacci normals of CONVENTIONS section 5";
 
+/// The Gauss-Newton matrix is estimated from every `HESSIAN_STRIDE`-th fitting normal.
+const HESSIAN_STRIDE: usize = 2;
+
 /// Rows of `Phi` per parallel Gram block (fixed, so sums are thread-count independent).
 const GRAM_BLOCK: usize = 512;
 
@@ -682,25 +685,28 @@ fn gram(x: &DMatrix<f64>) -> DMatrix<f64> {
 }
 
 /// The Gram matrix `Phi^T Phi` that sets the Gauss-Newton step, estimated cheaply: from every
-/// other fitting normal (scaled by 2) and multiplied in f32. It is used only for the step, never
-/// for the cost or the gradient (both exact, on every normal), so the trust test still accepts
-/// only true decreases and the fit stops at the same kind of stationary point; the estimate (about
-/// 1e-3 relative for a Fibonacci set halved, 1e-6 for the f32 rounding) changes the path, at a
-/// quarter of the cost of the exact product.
+/// [`HESSIAN_STRIDE`]-th fitting normal (scaled back up) and multiplied in f32. It is used only
+/// for the step, never for the cost or the gradient (both exact, on every normal), so the trust
+/// test still accepts only true decreases and the fit stops at the same kind of stationary point;
+/// the estimate changes the path, at a fraction of the cost of the exact product.
 fn hessian_gram(x: &DMatrix<f64>) -> DMatrix<f64> {
     let (m, n) = x.shape();
-    let half = m / 2;
-    let starts: Vec<usize> = (0..half).step_by(GRAM_BLOCK).collect();
+    let sampled = m / HESSIAN_STRIDE;
+    let starts: Vec<usize> = (0..sampled).step_by(GRAM_BLOCK).collect();
     let parts: Vec<DMatrix<f32>> = starts
         .par_iter()
         .map(|&s| {
             let rows = x
-                .rows_with_step(2 * s, GRAM_BLOCK.min(half - s), 1)
+                .rows_with_step(
+                    HESSIAN_STRIDE * s,
+                    GRAM_BLOCK.min(sampled - s),
+                    HESSIAN_STRIDE - 1,
+                )
                 .map(|v| v as f32);
             rows.transpose() * rows
         })
         .collect();
-    let scale = m as f64 / half.max(1) as f64;
+    let scale = m as f64 / sampled.max(1) as f64;
     parts
         .into_iter()
         .fold(DMatrix::<f32>::zeros(n, n), |acc, p| acc + p)
