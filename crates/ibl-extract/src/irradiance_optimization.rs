@@ -79,7 +79,8 @@ const GRAM_BLOCK: usize = 512;
 /// Optimisation settings. The fit is deterministic (no random choices).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct OptimizationOptions {
-    /// Most Levenberg-Marquardt iterations at the final level.
+    /// Most Levenberg-Marquardt iterations at the final level (a safety cap: fits on probes with
+    /// small, very bright sources can need several hundred).
     pub max_iterations: usize,
     /// Most iterations at each intermediate continuation level.
     pub level_iterations: usize,
@@ -90,7 +91,7 @@ pub struct OptimizationOptions {
 impl Default for OptimizationOptions {
     fn default() -> Self {
         OptimizationOptions {
-            max_iterations: 300,
+            max_iterations: 2000,
             level_iterations: 20,
             relative_tolerance: 1e-4,
         }
