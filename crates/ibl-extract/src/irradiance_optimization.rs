@@ -50,6 +50,7 @@
 use std::collections::BTreeMap;
 
 use glam::{DMat3, DVec3};
+use ibl_core::rgb::Rgb64;
 use ibl_core::{Image, Rgb, RowIrradiance, channel_means, fibonacci_normals};
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
@@ -374,8 +375,7 @@ fn black_fit(n: usize) -> Fit {
 /// lights of half its power, a small angle apart along its first tangent.
 fn split_strongest(lights: &mut Lights, count: usize) {
     let mut order: Vec<usize> = (0..lights.len()).collect();
-    let lum = |p: [f64; 3]| 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
-    order.sort_by(|&a, &b| lum(lights.power(b)).total_cmp(&lum(lights.power(a))));
+    order.sort_by(|&a, &b| luminance(lights.power(b)).total_cmp(&luminance(lights.power(a))));
     let spread = 0.25 * (4.0 * std::f64::consts::PI / count as f64).sqrt();
     for &i in order.iter().take(count - lights.len()) {
         let (t1, _) = tangents(lights.dirs[i]);
@@ -386,6 +386,16 @@ fn split_strongest(lights: &mut Lights, count: usize) {
         lights.log_power[i] = half;
         lights.log_power.push(half);
     }
+}
+
+/// Rec. 709 luminance of an RGB power (the project's weights, `Rgb64::luminance`).
+fn luminance(p: [f64; 3]) -> f64 {
+    Rgb64 {
+        r: p[0],
+        g: p[1],
+        b: p[2],
+    }
+    .luminance()
 }
 
 /// An orthonormal tangent basis `(t1, t2)` at unit `w` (deterministic).
@@ -657,9 +667,7 @@ impl Problem {
                 }
             })
             .collect();
-        let lum = |l: &Light| {
-            0.2126 * l.irradiance[0] + 0.7152 * l.irradiance[1] + 0.0722 * l.irradiance[2]
-        };
+        let lum = |l: &Light| luminance(l.irradiance);
         out.sort_by(|a, b| lum(b).total_cmp(&lum(a)));
         LightSet {
             method: "irradiance-optimization".into(),
