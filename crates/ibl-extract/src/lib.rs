@@ -8,9 +8,11 @@ mod cholesky;
 pub mod irradiance_optimization;
 pub mod light_set;
 pub mod lightgen;
+mod lune_gram;
 pub mod median_cut;
 pub mod method;
 pub mod nnls;
+mod normal_lanes;
 mod region_stats;
 pub mod variance_minimization;
 

@@ -12,7 +12,7 @@ use std::time::Instant;
 
 use ibl_core::glam::DVec3;
 use ibl_core::{Image, LatLong, Rgb, channel_means, fibonacci_normals, irradiance_exact};
-use ibl_extract::irradiance_optimization::fit_normals;
+use ibl_extract::irradiance_optimization::{FIT_NORMAL_COUNT, fit_irradiance, fit_normals};
 use ibl_extract::{OptimizationOptions, irradiance_optimization};
 
 fn probes() -> Vec<(String, Image<Rgb>)> {
@@ -66,7 +66,7 @@ fn score(probe: &Image<Rgb>, n: usize) -> (f64, f64, ibl_extract::Fit) {
 fn fit_normals_are_not_the_scoring_normals() {
     let fit = fit_normals();
     let scoring = fibonacci_normals(20_000);
-    assert_eq!(fit.len(), 4096);
+    assert_eq!(fit.len(), FIT_NORMAL_COUNT);
     // No fitting normal lies within 1e-6 rad of a scoring normal (checked on a subset).
     for f in fit.iter().step_by(64) {
         let closest = scoring.iter().map(|s| s.dot(*f)).fold(-1.0f64, f64::max);
@@ -205,4 +205,31 @@ fn bundled_probes_converge_and_score_within_bounds() {
             }
         }
     }
+}
+
+#[test]
+fn fit_irradiance_refuses_normals_that_do_not_cover_the_sphere() {
+    // The step model assumes evenly spread normals: a hemisphere, too few normals or a
+    // non-unit normal is refused with a message, never fitted badly.
+    let all = fibonacci_normals(2000);
+    let target = |normals: &[DVec3]| -> Vec<[f64; 3]> {
+        normals
+            .iter()
+            .map(|n| [2.0 * n.y.max(0.0) + 0.5 * n.x.max(0.0); 3])
+            .collect()
+    };
+    let hemisphere: Vec<DVec3> = all.iter().copied().filter(|n| n.y > 0.0).collect();
+    let options = OptimizationOptions::default();
+    let err = fit_irradiance(hemisphere.clone(), target(&hemisphere), 4, &options).unwrap_err();
+    assert!(err.to_string().contains("cover the sphere evenly"), "{err}");
+    let few = fibonacci_normals(32);
+    assert!(fit_irradiance(few.clone(), target(&few), 4, &options).is_err());
+    let mut scaled = all.clone();
+    scaled[7] *= 2.0;
+    let err = fit_irradiance(scaled.clone(), target(&scaled), 4, &options).unwrap_err();
+    assert!(err.to_string().contains("normal 7"), "{err}");
+    // Evenly spread normals of any count fit: the target is exactly two lights.
+    let fit = fit_irradiance(all.clone(), target(&all), 2, &options).unwrap();
+    assert!(fit.report.converged);
+    assert!(fit.report.fit_mean_abs_err_pct < 0.01, "{:?}", fit.report);
 }
