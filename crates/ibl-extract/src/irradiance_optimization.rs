@@ -62,12 +62,12 @@ use std::collections::BTreeMap;
 use glam::{DMat3, DVec3};
 use ibl_core::rgb::Rgb64;
 use ibl_core::{Image, Rgb, RowIrradiance, channel_means, fibonacci_normals};
-use nalgebra::{DMatrix, DVector};
+use nalgebra::{DMatrix, DMatrixViewMut, DVector};
 use rayon::prelude::*;
 
-use crate::cholesky::{cholesky_lower, cholesky_solve};
+use crate::cholesky::{cholesky_in_place, cholesky_solve};
 use crate::light_set::{Light, LightSet};
-use crate::lune_gram::{cosine_overlap, uniform_gram};
+use crate::lune_gram::{cosine_overlap, feature_block};
 use crate::normal_lanes::{ChannelValues, NormalLanes};
 use crate::{ExtractError, nnls_gram};
 
@@ -83,9 +83,9 @@ pub const MAX_LIGHTS: usize = 1024;
 /// What the fit is scored against, in words for reports: the fit never sees the scoring normals.
 pub const FIT_NORMALS_NOTE: &str = "fitted on 6144 Fibonacci normals turned by 0.5 rad about the axis (1,1,1); scored on the 20000 Fibonacci normals of CONVENTIONS section 5";
 
-/// Rows per parallel block of the Gram product in the power solve (fixed, so sums do not depend
-/// on the thread count).
-const GRAM_BLOCK: usize = 512;
+/// Columns per parallel block of the Gram product in the power solve (fixed, so results do not
+/// depend on the thread count).
+const GRAM_BLOCK: usize = 32;
 
 /// Optimisation settings. The fit is deterministic (no random choices).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -664,19 +664,26 @@ impl Problem {
         }
     }
 
-    /// The Gauss-Newton normal equations `H = J^T J`, `g = J^T r` (parameters per light:
-    /// `u, v, s_r, s_g, s_b`; see the module doc for the structure used).
-    fn normal_equations(&self, lights: &Lights, r: &ChannelValues) -> (DMatrix<f64>, DVector<f64>) {
+    /// The Gauss-Newton normal equations: writes the lower triangle of `H = J^T J` (5N x 5N,
+    /// parameters per light `u, v, s_r, s_g, s_b`; the upper triangle is left as it was) into `h`
+    /// and returns `g = J^T r`. See the module doc for the structure used: the gradient is exact,
+    /// O(M N); `H` is built pair by pair from the closed-form Gram blocks, O(N^2).
+    fn normal_equations(
+        &self,
+        lights: &Lights,
+        r: &ChannelValues,
+        h: &mut DMatrix<f64>,
+    ) -> DVector<f64> {
         let nl = lights.len();
+        let m = self.normals.len();
         let basis: Vec<(DVec3, DVec3)> = lights.dirs.iter().map(|w| tangents(*w)).collect();
         // Per light and channel, S = sum of r n over the normals facing the light: the features
-        // c, a, b summed against the residual are w.S, t1.S, t2.S. Exact, O(M N).
+        // c, a, b summed against the residual are w.S, t1.S, t2.S.
         let sums: Vec<[DVec3; 3]> = lights
             .dirs
             .par_iter()
             .map(|&w| self.lanes.lit_residual_sums(w, r))
             .collect();
-        let q = uniform_gram(&lights.dirs, &basis, self.normals.len());
         // alpha_ic = I_ic / mu_c: the Jacobian's per-light, per-channel factor.
         let alpha: Vec<[f64; 3]> = (0..nl)
             .map(|i| {
@@ -694,32 +701,33 @@ impl Problem {
                 g[5 * i + 2 + c] = alpha[i][c] * w.dot(sums[i][c]);
             }
         }
-        let mut h = DMatrix::zeros(np, np);
         h.as_mut_slice()
             .par_chunks_mut(np * 5)
             .enumerate()
             .for_each(|(j, cols)| {
-                // Columns 5j..5j+5 of H (column-major), all rows.
-                for i in 0..nl {
+                // Columns 5j..5j+5 of H (column-major), rows of lights i >= j.
+                for i in j..nl {
+                    // q[x][y]: features x of light i against y of light j (0 = c, 1 = a, 2 = b).
+                    let q = feature_block(lights.dirs[i], basis[i], lights.dirs[j], basis[j], m);
                     let w = [0, 1, 2].map(|c| alpha[i][c] * alpha[j][c]);
                     let ws = w[0] + w[1] + w[2];
-                    let (ci, ai, bi) = (3 * i, 3 * i + 1, 3 * i + 2);
-                    let (cj, aj, bj) = (3 * j, 3 * j + 1, 3 * j + 2);
                     let mut set = |row: usize, col: usize, v: f64| cols[col * np + 5 * i + row] = v;
-                    set(0, 0, ws * q[(ai, aj)]);
-                    set(1, 0, ws * q[(bi, aj)]);
-                    set(0, 1, ws * q[(ai, bj)]);
-                    set(1, 1, ws * q[(bi, bj)]);
+                    set(0, 0, ws * q[1][1]);
+                    set(1, 0, ws * q[2][1]);
+                    set(0, 1, ws * q[1][2]);
+                    set(1, 1, ws * q[2][2]);
                     for (c, wc) in w.into_iter().enumerate() {
-                        set(2 + c, 0, wc * q[(ci, aj)]);
-                        set(2 + c, 1, wc * q[(ci, bj)]);
-                        set(0, 2 + c, wc * q[(ai, cj)]);
-                        set(1, 2 + c, wc * q[(bi, cj)]);
-                        set(2 + c, 2 + c, wc * q[(ci, cj)]);
+                        set(2 + c, 0, wc * q[0][1]);
+                        set(2 + c, 1, wc * q[0][2]);
+                        set(0, 2 + c, wc * q[1][0]);
+                        set(1, 2 + c, wc * q[2][0]);
+                        for c2 in 0..3 {
+                            set(2 + c, 2 + c2, if c == c2 { wc * q[0][0] } else { 0.0 });
+                        }
                     }
                 }
             });
-        (h, g)
+        g
     }
 
     /// The fitted lights as a light set, strongest (luminance power) first.
@@ -747,21 +755,29 @@ impl Problem {
     }
 }
 
-/// `X^T X` for a tall column-major matrix: blocks of [`GRAM_BLOCK`] rows multiplied in parallel
-/// (blocked matrix products) and summed in a fixed order.
+/// `X^T X` for a tall column-major matrix: its lower triangle by blocks of [`GRAM_BLOCK`] columns
+/// (one matrix product each, in parallel), mirrored to the upper. O(M N^2 / 2).
 fn gram(x: &DMatrix<f64>) -> DMatrix<f64> {
     let (m, n) = x.shape();
-    let starts: Vec<usize> = (0..m).step_by(GRAM_BLOCK).collect();
-    let parts: Vec<DMatrix<f64>> = starts
-        .par_iter()
-        .map(|&s| {
-            let rows = x.rows(s, GRAM_BLOCK.min(m - s));
-            rows.transpose() * rows
-        })
-        .collect();
-    parts
-        .into_iter()
-        .fold(DMatrix::zeros(n, n), |acc, p| acc + p)
+    let mut q = DMatrix::zeros(n, n);
+    if n == 0 || m == 0 {
+        return q;
+    }
+    // nalgebra's `gemm_tr` is a loop of dot products; `gemm` on the transpose is a blocked product.
+    let xt = x.transpose();
+    q.as_mut_slice()
+        .par_chunks_mut(GRAM_BLOCK * n)
+        .enumerate()
+        .for_each(|(b, cols)| {
+            let c0 = b * GRAM_BLOCK;
+            let width = cols.len() / n;
+            let mut block = DMatrixViewMut::from_slice(cols, n, width);
+            block
+                .rows_mut(c0, n - c0)
+                .gemm(1.0, &xt.rows(c0, n - c0), &x.columns(c0, width), 0.0);
+        });
+    q.fill_upper_triangle_with_lower_triangle();
+    q
 }
 
 /// Damped Gauss-Newton (Levenberg-Marquardt) on `lights`, at most `max_iterations` iterations.
@@ -778,13 +794,18 @@ fn levenberg_marquardt(
     let mut iterations = 0;
     let mut converged = false;
     let mut small_steps = 0;
+    // H (lower triangle) and the damped copy that is factored in place: allocated once per run.
+    let np = 5 * lights.len();
+    let mut h = DMatrix::zeros(np, np);
+    let mut a = DMatrix::zeros(np, np);
+    let mut hd = DVector::zeros(np);
     while iterations < max_iterations {
         iterations += 1;
         if cost <= 1e-30 {
             converged = true;
             break;
         }
-        let (h, g) = problem.normal_equations(lights, &r);
+        let g = problem.normal_equations(lights, &r, &mut h);
         // First-order optimality (MINPACK's gtol): the residual is orthogonal to every Jacobian
         // column to within GRADIENT_TOLERANCE (cosine of the angle between them).
         let r_norm = (2.0 * cost).sqrt();
@@ -799,19 +820,25 @@ fn levenberg_marquardt(
         let floor = 1e-6 * max_diag.max(f64::MIN_POSITIVE);
         let mut accepted = false;
         while lambda < 1e16 {
-            let mut a = h.clone();
-            for i in 0..a.nrows() {
+            a.copy_from(&h);
+            for i in 0..np {
                 a[(i, i)] += lambda * h[(i, i)].max(floor);
             }
-            let Some(delta) = cholesky_lower(a).and_then(|l| cholesky_solve(&l, &(-&g))) else {
+            let delta = if cholesky_in_place(&mut a) {
+                cholesky_solve(&a, &(-&g))
+            } else {
+                None
+            };
+            let Some(delta) = delta else {
                 lambda *= nu;
                 nu *= 2.0;
                 continue;
             };
             let trial = apply_step(lights, &delta);
             let (tr, tcost) = problem.residuals(&trial);
-            // Predicted reduction of the quadratic model: -g.d - 1/2 d.H.d.
-            let predicted = -g.dot(&delta) - 0.5 * delta.dot(&(&h * &delta));
+            // Predicted reduction of the quadratic model: -g.d - 1/2 d.H.d (H's lower triangle).
+            hd.sygemv(1.0, &h, &delta, 0.0);
+            let predicted = -g.dot(&delta) - 0.5 * delta.dot(&hd);
             if tcost < cost && tcost.is_finite() {
                 let rho = if predicted > 0.0 {
                     (cost - tcost) / predicted

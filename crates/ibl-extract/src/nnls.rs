@@ -11,11 +11,20 @@
 //!
 //! Active-set method: add the variable with the most positive gradient to the free set, solve the
 //! unconstrained problem on the free set by Cholesky, step back to the feasible boundary when a
-//! free variable would go negative. Cost O(n^3) per solve and at most `3 n` outer steps; in
-//! practice a few dozen. A tiny ridge (`1e-12` of the mean diagonal) keeps the free-set systems
-//! positive definite when lights coincide.
+//! free variable would go negative. Cost O(n^3) per solve and at most `3 n` outer steps. A tiny
+//! ridge (`1e-12` of the mean diagonal) keeps the free-set systems positive definite when lights
+//! coincide.
+//!
+//! Warm start: the fits need powers for many lights of which nearly all end up positive, and
+//! adding them one at a time would cost n solves, O(n^4). So the free set starts as every
+//! variable: solve, drop the variables that come out non-positive, solve again, until all are
+//! positive. That point is optimal on its free set and feasible, which is all the active-set
+//! loop needs to start from; it then adds back any variable whose gradient asks for it, so the
+//! answer is the same NNLS optimum.
 
 use nalgebra::{DMatrix, DVector};
+
+use crate::cholesky::{cholesky_lower, cholesky_solve};
 
 /// Solves `min 1/2 x^T Q x - b^T x, x >= 0` (see the module doc). `q` is n x n, `b` has n rows.
 /// Returns zeros when `b` has no positive entry (the best non-negative answer then) or `Q` is
@@ -33,7 +42,7 @@ pub fn nnls_gram(q: &DMatrix<f64>, b: &DVector<f64>) -> DVector<f64> {
     let ridge = 1e-12 * mean_diag;
     let scale = b.amax().max(f64::MIN_POSITIVE);
     let tol = 1e-13 * scale;
-    let mut free = vec![false; n];
+    let mut free = warm_start(q, b, ridge, &mut x);
     for _ in 0..3 * n {
         // Gradient of the negative objective: w = b - Q x.
         let w = b - q * &x;
@@ -80,6 +89,34 @@ pub fn nnls_gram(q: &DMatrix<f64>, b: &DVector<f64>) -> DVector<f64> {
     x
 }
 
+/// The warm start (see the module doc): the largest free set, from all variables down, whose
+/// unconstrained solution is positive; `x` gets that solution. Empty (and `x = 0`) if none is
+/// found or a system is not positive definite.
+fn warm_start(q: &DMatrix<f64>, b: &DVector<f64>, ridge: f64, x: &mut DVector<f64>) -> Vec<bool> {
+    let n = b.len();
+    let mut free = vec![true; n];
+    loop {
+        let idx: Vec<usize> = (0..n).filter(|&i| free[i]).collect();
+        if idx.is_empty() {
+            return free;
+        }
+        let Some(z) = solve_subset(q, b, &idx, ridge) else {
+            return vec![false; n];
+        };
+        if z.iter().all(|&v| v > 0.0) {
+            for (k, &i) in idx.iter().enumerate() {
+                x[i] = z[k];
+            }
+            return free;
+        }
+        for (k, &i) in idx.iter().enumerate() {
+            if z[k] <= 0.0 {
+                free[i] = false;
+            }
+        }
+    }
+}
+
 /// Solves `Q_SS z = b_S` on the index subset `S` (with a ridge); `None` if not positive definite.
 fn solve_subset(q: &DMatrix<f64>, b: &DVector<f64>, idx: &[usize], ridge: f64) -> Option<Vec<f64>> {
     let k = idx.len();
@@ -87,7 +124,7 @@ fn solve_subset(q: &DMatrix<f64>, b: &DVector<f64>, idx: &[usize], ridge: f64) -
         q[(idx[r], idx[c])] + if r == c { ridge } else { 0.0 }
     });
     let rhs = DVector::from_fn(k, |r, _| b[idx[r]]);
-    let z = sub.cholesky()?.solve(&rhs);
+    let z = cholesky_solve(&cholesky_lower(sub)?, &rhs)?;
     Some(z.iter().copied().collect())
 }
 
