@@ -23,6 +23,7 @@
 //! blocks and then runs the brute-force loop over them (64x fewer emitters on a 512 x 256 probe).
 
 use ibl_core::glam::DVec3;
+use ibl_core::rgb::Rgb64;
 use ibl_core::{Image, LatLong, Rgb, channel_means, fibonacci_normals, irradiance_exact};
 use rayon::prelude::*;
 
@@ -129,7 +130,12 @@ impl Emitters {
                 let b = row + i * bw / w;
                 let p = [l[0] * omega, l[1] * omega, l[2] * omega];
                 // Luminance weights (Rec. 709), or the plain sum if a colour has zero luminance.
-                let y = 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+                let y = Rgb64 {
+                    r: p[0],
+                    g: p[1],
+                    b: p[2],
+                }
+                .luminance();
                 let y = if y > 0.0 { y } else { p[0] + p[1] + p[2] };
                 dir[b] += ll.pixel_dir64(i, j) * y;
                 lum[b] += y;

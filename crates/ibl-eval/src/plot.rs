@@ -339,32 +339,44 @@ fn subtitle(report: &Report) -> String {
     )
 }
 
+/// One curve per method of the report, over its sorted counts, with the (mean, max) errors that
+/// `errors(method, n)` finds (`None` where there is no result).
+fn curves(
+    report: &Report,
+    errors: impl Fn(&str, usize) -> (Option<f64>, Option<f64>),
+) -> Vec<Curve> {
+    let counts = sorted_counts(report);
+    report
+        .methods
+        .iter()
+        .map(|m| Curve {
+            method: m.clone(),
+            points: counts
+                .iter()
+                .map(|&n| {
+                    let (mean_err_pct, max_err_pct) = errors(m, n);
+                    CurvePoint {
+                        n,
+                        mean_err_pct,
+                        max_err_pct,
+                    }
+                })
+                .collect(),
+        })
+        .collect()
+}
+
 impl ErrorChart {
     /// The chart of probe `index` of a report (`None` if there is no such probe).
     pub fn for_probe(report: &Report, index: usize) -> Option<Self> {
         let probe = report.probes.get(index)?;
-        let counts = sorted_counts(report);
-        let curves = report
-            .methods
-            .iter()
-            .map(|m| Curve {
-                method: m.clone(),
-                points: counts
-                    .iter()
-                    .map(|&n| {
-                        let row = probe
-                            .rows
-                            .iter()
-                            .find(|r| &r.method == m && r.n == n && r.status == Status::Ok);
-                        CurvePoint {
-                            n,
-                            mean_err_pct: row.and_then(|r| r.mean_err_pct),
-                            max_err_pct: row.and_then(|r| r.max_err_pct),
-                        }
-                    })
-                    .collect(),
-            })
-            .collect();
+        let curves = curves(report, |m, n| {
+            probe
+                .rows
+                .iter()
+                .find(|r| r.method == m && r.n == n && r.status == Status::Ok)
+                .map_or((None, None), |r| (r.mean_err_pct, r.max_err_pct))
+        });
         Some(ErrorChart {
             title: probe.name.clone(),
             subtitle: subtitle(report),
@@ -374,26 +386,16 @@ impl ErrorChart {
 
     /// The chart of the averages over every probe of a report.
     pub fn average(report: &Report) -> Self {
-        let counts = sorted_counts(report);
         let k = report.probes.len();
-        let curves = report
-            .methods
-            .iter()
-            .map(|m| Curve {
-                method: m.clone(),
-                points: counts
-                    .iter()
-                    .map(|&n| {
-                        let a = report.averages.iter().find(|a| &a.method == m && a.n == n);
-                        CurvePoint {
-                            n,
-                            mean_err_pct: a.map(|a| a.mean_err_pct),
-                            max_err_pct: a.map(|a| a.max_err_pct),
-                        }
-                    })
-                    .collect(),
-            })
-            .collect();
+        let curves = curves(report, |m, n| {
+            report
+                .averages
+                .iter()
+                .find(|a| a.method == m && a.n == n)
+                .map_or((None, None), |a| {
+                    (Some(a.mean_err_pct), Some(a.max_err_pct))
+                })
+        });
         ErrorChart {
             title: format!("average over {k} probe{}", if k == 1 { "" } else { "s" }),
             subtitle: subtitle(report),

@@ -315,13 +315,7 @@ pub fn fit_irradiance(
                     Growth::Split => split_strongest(&mut candidate, level),
                     Growth::Insert => problem.insert_at_deficits(&mut candidate, level),
                 }
-                problem.solve_powers(&mut candidate);
-                let outcome = levenberg_marquardt(
-                    &problem,
-                    &mut candidate,
-                    options.level_iterations,
-                    options.relative_tolerance,
-                );
+                let outcome = problem.refit(&mut candidate, options.level_iterations, options);
                 total_iterations += outcome.iterations;
                 if best
                     .as_ref()
@@ -361,13 +355,7 @@ pub fn fit_irradiance(
             break;
         };
         problem.insert_at_deficits(&mut candidate, n);
-        problem.solve_powers(&mut candidate);
-        let outcome = levenberg_marquardt(
-            &problem,
-            &mut candidate,
-            options.max_iterations,
-            options.relative_tolerance,
-        );
+        let outcome = problem.refit(&mut candidate, options.max_iterations, options);
         total_iterations += outcome.iterations;
         if outcome.final_cost >= report.final_cost {
             break;
@@ -520,6 +508,18 @@ struct Outcome {
 }
 
 impl Problem {
+    /// Fits lights that were just added or moved: powers by NNLS, then Levenberg-Marquardt for
+    /// at most `max_iterations`.
+    fn refit(
+        &self,
+        lights: &mut Lights,
+        max_iterations: usize,
+        options: &OptimizationOptions,
+    ) -> Outcome {
+        self.solve_powers(lights);
+        levenberg_marquardt(self, lights, max_iterations, options.relative_tolerance)
+    }
+
     /// The fitting normal with the largest luminance-weighted irradiance (the start of the
     /// one-light fit).
     fn brightest_normal(&self) -> DVec3 {
