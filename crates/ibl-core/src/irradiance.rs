@@ -35,8 +35,8 @@ use rayon::prelude::*;
 
 use crate::{Image, LatLong, Rgb};
 
-/// Clamps invalid radiance (negative, NaN, infinite) to 0, as f64.
-fn valid_radiance(v: f32) -> f64 {
+/// Clamps invalid radiance (negative, NaN, infinite) to 0, as f64 (CONVENTIONS section 4).
+pub fn valid_radiance(v: f32) -> f64 {
     if v.is_finite() && v > 0.0 {
         f64::from(v)
     } else {

@@ -24,7 +24,10 @@
 
 use ibl_core::glam::DVec3;
 use ibl_core::rgb::Rgb64;
-use ibl_core::{Image, LatLong, Rgb, channel_means, fibonacci_normals, irradiance_exact};
+use ibl_core::{
+    Image, LatLong, Rgb, channel_means, fibonacci_normals, irradiance_exact,
+    valid_radiance as radiance,
+};
 use rayon::prelude::*;
 
 /// Normals served by one pass over the pixels (lanes of the vectorised inner loop). Two f64
@@ -53,15 +56,6 @@ pub struct Emitters {
     pub wg: Vec<f64>,
     /// Blue weights.
     pub wb: Vec<f64>,
-}
-
-/// Clamps invalid radiance (negative, NaN, infinite) to 0, as f64.
-fn radiance(v: f32) -> f64 {
-    if v.is_finite() && v > 0.0 {
-        f64::from(v)
-    } else {
-        0.0
-    }
 }
 
 impl Emitters {

@@ -1,0 +1,27 @@
+//! Spherical harmonics for iblkit (CONVENTIONS section 6): the real orthonormal basis of any
+//! order, projection of lat-long probes with exact solid angles, rotation of every band, Lambert
+//! convolution to irradiance (Ramamoorthi & Hanrahan 2001) with optional windowing, and the
+//! radiance and irradiance coefficient sets as distinct types.
+
+pub mod basis;
+pub mod coefficients;
+pub mod convolution;
+pub mod projection;
+pub mod rotation;
+
+pub use basis::{MAX_BANDS, basis, coefficient_count, eval_basis, sh_index};
+pub use coefficients::{IrradianceSh, RadianceSh};
+pub use convolution::{Window, lambert_factor};
+pub use projection::project_latlong;
+pub use rotation::ShRotation;
+
+/// Why an SH operation could not run.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum ShError {
+    /// A parameter is out of range (band count).
+    #[error("{0}")]
+    Parameter(String),
+    /// The data is not usable (wrong coefficient count, non-finite values, empty probe).
+    #[error("{0}")]
+    Invalid(String),
+}
