@@ -37,7 +37,7 @@ enum Command {
     Info(cmd::info::InfoArgs),
     /// Convert between file formats and environment-map mappings, with rotation.
     Convert(cmd::convert::ConvertArgs),
-    /// Ground-truth irradiance of a lat-long probe on Fibonacci normals, as CSV.
+    /// Irradiance from a lat-long probe: on Fibonacci normals (CSV) or as a map (exact, fast, SH).
     Irradiance(cmd::irradiance::IrradianceArgs),
     /// Approximate a lat-long probe by N directional lights; write JSON, glTF, Mitsuba or pbrt.
     Lights(cmd::lights::LightsArgs),
