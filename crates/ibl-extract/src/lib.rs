@@ -5,6 +5,7 @@
 
 pub mod adaptive_median_cut;
 mod cholesky;
+pub mod hybrid;
 pub mod irradiance_optimization;
 pub mod light_set;
 pub mod lightgen;
@@ -14,15 +15,18 @@ pub mod method;
 pub mod nnls;
 mod normal_lanes;
 mod region_stats;
+pub mod sun;
 pub mod variance_minimization;
 
 pub use adaptive_median_cut::adaptive_median_cut;
+pub use hybrid::Hybrid;
 pub use irradiance_optimization::{Fit, FitReport, OptimizationOptions, irradiance_optimization};
 pub use light_set::{Light, LightSet, PixelRegion};
 pub use lightgen::{LightGenOptions, lightgen};
 pub use median_cut::median_cut;
 pub use method::{ExtractOptions, Extraction, Method, extract};
 pub use nnls::nnls_gram;
+pub use sun::{DominantLight, dominant_light};
 pub use variance_minimization::variance_minimization;
 
 /// Why a light set could not be extracted.
