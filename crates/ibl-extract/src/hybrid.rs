@@ -48,8 +48,8 @@ impl Hybrid {
         for light in &lights.lights {
             let y = basis(light.dir(), bands);
             for (c, yk) in coeffs.iter_mut().zip(&y) {
-                for ch in 0..3 {
-                    c[ch] -= light.irradiance[ch] * yk;
+                for (v, power) in c.iter_mut().zip(light.irradiance) {
+                    *v -= power * yk;
                 }
             }
         }
