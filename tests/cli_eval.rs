@@ -202,3 +202,50 @@ fn eval_help_has_examples() {
         "{text}"
     );
 }
+
+#[test]
+fn hybrid_and_sh_models_are_scored_beside_light_sets() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("hybrid");
+    let sky = probe("sky.exr");
+    let o = ibl(&[
+        "eval",
+        &sky,
+        "--methods",
+        "sun+sh3,sh3,lightgen,lightgen+sh3",
+        "--n",
+        "1,4",
+        "--normals",
+        "2000",
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let rows = report["probes"][0]["rows"].as_array().unwrap();
+    let row = |m: &str, n: u64| {
+        rows.iter()
+            .find(|r| r["method"] == m && r["n"] == n)
+            .unwrap()
+            .clone()
+    };
+    let err = |m: &str, n: u64| row(m, n)["mean_err_pct"].as_f64().unwrap();
+    // The sky has a hard sun: 1 sun + SH9 is far better than SH9 alone, and beats 4 lights.
+    assert!(err("sun+sh3", 1) < 0.2 * err("sh3", 1));
+    assert!(err("sun+sh3", 1) < err("lightgen", 4));
+    assert_eq!(row("sun+sh3", 1)["parameters"]["sun_used"], 1.0);
+    assert_eq!(row("sun+sh3", 4)["status"], "skipped");
+    // SH alone has no lights and the same error at every N; the ambient helps the lights.
+    assert_eq!(row("sh3", 4)["lights"], 0);
+    assert_eq!(err("sh3", 1), err("sh3", 4));
+    assert!(err("lightgen+sh3", 4) < err("lightgen", 4));
+    // Power is conserved by every model (SH9 and the hybrids exactly).
+    for r in rows.iter().filter(|r| r["status"] == "ok") {
+        assert!(r["power_change_pct"].as_f64().unwrap().abs() < 1e-6, "{r}");
+    }
+    // Figures are drawn for light sets only.
+    assert!(out.join("overlays/sky-lightgen-4.png").exists());
+    assert!(!out.join("overlays/sky-sh3-4.png").exists());
+    assert!(!out.join("overlays/sky-lightgen+sh3-4.png").exists());
+}

@@ -158,7 +158,9 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
     }
     bar.finish_and_clear();
     let settings = eval::EvalSettings::new(
-        ibl_extract::Method::ALL.to_vec(),
+        ibl_extract::Method::ALL
+            .map(ibl_extract::ModelSpec::from)
+            .to_vec(),
         DEMO_EVAL_COUNTS.to_vec(),
         ibl_core::fibonacci::DEFAULT_NORMAL_COUNT,
         ibl_extract::ExtractOptions::default().seed,

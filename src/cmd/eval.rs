@@ -27,7 +27,7 @@ use ibl_eval::{
     ErrorChart, FigureFiles, PLOT_SIZE, PlotFiles, ProbeInput, Report, SphereField, SphereFigure,
     SweepOptions,
 };
-use ibl_extract::{ExtractOptions, Method};
+use ibl_extract::{ExtractOptions, Method, ModelSpec};
 use ibl_mapping::Mapping;
 
 use crate::envmap_files::{self, MappingArg};
@@ -60,8 +60,10 @@ pub struct EvalArgs {
     /// Lat-long probes (.exr, .hdr, .pfm, .png, .jpg).
     #[arg(required = true, value_name = "PROBE")]
     pub probes: Vec<PathBuf>,
-    /// Methods: `all`, or a comma-separated list of median-cut, adaptive-median-cut, lightgen,
-    /// variance-minimization, irradiance-optimization.
+    /// Methods: `all` (the five light methods), or a comma-separated list of median-cut,
+    /// adaptive-median-cut, lightgen, variance-minimization, irradiance-optimization, sun (the
+    /// dominant light, N = 1), any of them with an SH ambient (`lightgen+sh3`, `sun+sh3`: 1 sun +
+    /// SH9), or SH alone (`sh3`, `sh21`).
     #[arg(long, default_value = "all", value_name = "LIST")]
     pub methods: String,
     /// Light counts N, comma-separated (median cut runs only on powers of two).
@@ -95,7 +97,7 @@ pub struct EvalArgs {
 #[derive(Clone, Debug)]
 pub struct EvalSettings {
     /// Methods in report order.
-    pub methods: Vec<Method>,
+    pub methods: Vec<ModelSpec>,
     /// Light counts, increasing, without repeats.
     pub counts: Vec<usize>,
     /// Number of scoring normals.
@@ -110,7 +112,7 @@ impl EvalSettings {
     /// Checks and normalises the settings (counts sorted and deduplicated; the figure N defaults
     /// to 16 when swept, else the largest N).
     pub fn new(
-        methods: Vec<Method>,
+        methods: Vec<ModelSpec>,
         mut counts: Vec<usize>,
         normals: usize,
         seed: u64,
@@ -155,13 +157,13 @@ impl EvalSettings {
 }
 
 /// Parses `all` or a comma-separated list of method names (repeats dropped).
-pub fn parse_methods(list: &str) -> anyhow::Result<Vec<Method>> {
+pub fn parse_methods(list: &str) -> anyhow::Result<Vec<ModelSpec>> {
     if list.trim() == "all" {
-        return Ok(Method::ALL.to_vec());
+        return Ok(Method::ALL.map(ModelSpec::from).to_vec());
     }
     let mut out = Vec::new();
     for name in list.split(',').map(str::trim).filter(|s| !s.is_empty()) {
-        let m: Method = name.parse().map_err(|e| usage(format!("--methods: {e}")))?;
+        let m: ModelSpec = name.parse().map_err(|e| usage(format!("--methods: {e}")))?;
         if !out.contains(&m) {
             out.push(m);
         }
@@ -236,7 +238,7 @@ fn write_output(out: &Path, relative: &str, bytes: &[u8], inputs: &[&Path]) -> a
 }
 
 /// File stem of the figures of one probe, method and N.
-fn figure_stem(probe: &str, method: Method, n: usize) -> String {
+fn figure_stem(probe: &str, method: ModelSpec, n: usize) -> String {
     format!("{probe}-{method}-{n}")
 }
 
@@ -251,7 +253,12 @@ fn planned_outputs(probes: &[Probe], settings: &EvalSettings) -> Vec<String> {
         files.push(format!("plots/{stem}.png"));
     }
     for p in probes {
-        for &m in &settings.methods {
+        // Figures show light sets: models with an SH part have none.
+        for &m in settings
+            .methods
+            .iter()
+            .filter(|m| matches!(m, ModelSpec::Lights(_)))
+        {
             let stem = figure_stem(&p.name, m, settings.figure_n);
             files.push(format!("spheres/{stem}.png"));
             files.push(format!("overlays/{stem}.png"));
@@ -349,7 +356,7 @@ pub fn evaluate(paths: &[PathBuf], settings: &EvalSettings, out: &Path) -> anyho
         let row = p
             .rows
             .iter()
-            .find(|r| r.method == kept.method.name() && r.n == kept.n);
+            .find(|r| r.method == kept.method.to_string() && r.n == kept.n);
         let scores = row
             .and_then(|r| Some((r.mean_err_pct?, r.max_err_pct?)))
             .map(|(mean, max)| format!("mean_err {mean:.2} %, max_err {max:.2} %"))
@@ -372,7 +379,7 @@ pub fn evaluate(paths: &[PathBuf], settings: &EvalSettings, out: &Path) -> anyho
         write_output(out, &overlay, &png(&overlay_image, &overlay)?, &inputs)?;
         report.files.figures.push(FigureFiles {
             probe: p.name.clone(),
-            method: kept.method.name().to_string(),
+            method: kept.method.to_string(),
             n: kept.n,
             sphere: Some(sphere),
             overlay: Some(overlay),
@@ -454,25 +461,41 @@ mod tests {
 
     #[test]
     fn method_lists_parse() {
-        assert_eq!(parse_methods("all").unwrap(), Method::ALL.to_vec());
         assert_eq!(
-            parse_methods("median-cut, lightgen,median-cut").unwrap(),
-            vec![Method::MedianCut, Method::LightGen]
+            parse_methods("all").unwrap(),
+            Method::ALL.map(ModelSpec::from).to_vec()
+        );
+        assert_eq!(
+            parse_methods("median-cut, lightgen,median-cut,sun+sh3").unwrap(),
+            vec![
+                Method::MedianCut.into(),
+                Method::LightGen.into(),
+                "sun+sh3".parse().unwrap()
+            ]
         );
         assert!(parse_methods("nope").is_err());
     }
 
     #[test]
     fn settings_pick_the_figure_n() {
-        let s =
-            EvalSettings::new(vec![Method::MedianCut], vec![4, 1, 16, 4], 100, 1, None).unwrap();
+        let s = EvalSettings::new(
+            vec![Method::MedianCut.into()],
+            vec![4, 1, 16, 4],
+            100,
+            1,
+            None,
+        )
+        .unwrap();
         assert_eq!(s.counts, vec![1, 4, 16]);
         assert_eq!(s.figure_n, 16);
-        let s = EvalSettings::new(vec![Method::MedianCut], vec![1, 2], 100, 1, None).unwrap();
+        let s =
+            EvalSettings::new(vec![Method::MedianCut.into()], vec![1, 2], 100, 1, None).unwrap();
         assert_eq!(s.figure_n, 2);
-        assert!(EvalSettings::new(vec![Method::MedianCut], vec![1, 2], 100, 1, Some(8)).is_err());
-        assert!(EvalSettings::new(vec![Method::MedianCut], vec![0], 100, 1, None).is_err());
-        assert!(EvalSettings::new(vec![Method::MedianCut], vec![1], 0, 1, None).is_err());
+        assert!(
+            EvalSettings::new(vec![Method::MedianCut.into()], vec![1, 2], 100, 1, Some(8)).is_err()
+        );
+        assert!(EvalSettings::new(vec![Method::MedianCut.into()], vec![0], 100, 1, None).is_err());
+        assert!(EvalSettings::new(vec![Method::MedianCut.into()], vec![1], 0, 1, None).is_err());
     }
 
     #[test]

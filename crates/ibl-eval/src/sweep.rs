@@ -28,9 +28,8 @@ use std::fmt;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::time::Instant;
 
-use ibl_core::glam::DVec3;
 use ibl_core::{Image, LatLong, Rgb};
-use ibl_extract::{ExtractOptions, LightSet, Method};
+use ibl_extract::{ExtractOptions, LightSet, Method, Model, ModelSpec};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -55,8 +54,8 @@ pub struct ProbeInput<'a> {
 /// What to sweep.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SweepOptions {
-    /// Methods, in the order the report lists them.
-    pub methods: Vec<Method>,
+    /// Methods (lighting models: light sets, hybrids, SH), in the order the report lists them.
+    pub methods: Vec<ModelSpec>,
     /// Light counts N (each at least 1), in the order the report lists them.
     pub counts: Vec<usize>,
     /// Number M of Fibonacci scoring normals (at least 1; 20000 in the paper).
@@ -87,7 +86,7 @@ pub enum Stage {
     /// One method at one light count.
     Extract {
         /// The method.
-        method: Method,
+        method: ModelSpec,
         /// The light count.
         n: usize,
     },
@@ -232,7 +231,7 @@ pub struct KeptSet {
     /// Index of the probe in the input.
     pub probe: usize,
     /// The method.
-    pub method: Method,
+    pub method: ModelSpec,
     /// The light count asked for.
     pub n: usize,
     /// The lights.
@@ -316,9 +315,9 @@ fn json_number(v: f64) -> serde_json::Value {
 }
 
 /// A row with no metrics.
-fn empty_row(method: Method, n: usize, status: Status, reason: Option<String>) -> Row {
+fn empty_row(method: ModelSpec, n: usize, status: Status, reason: Option<String>) -> Row {
     Row {
-        method: method.name().to_string(),
+        method: method.to_string(),
         n,
         lights: None,
         mean_err_pct: None,
@@ -344,38 +343,30 @@ fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
     }
 }
 
-/// Irradiance of a light set on every normal, data-parallel (each normal's sum is a fixed
-/// sequential loop, so the result does not depend on the thread count).
-pub fn light_set_irradiance(set: &LightSet, normals: &[DVec3]) -> Vec<[f64; 3]> {
-    normals
-        .par_iter()
-        .with_min_len(256)
-        .map(|&n| set.irradiance_at(n))
-        .collect()
-}
-
-/// Runs one method at one N and scores it; returns the row and, when it ran, the light set.
+/// Runs one method at one N and scores it; returns the row and, when it ran, its light set.
 fn run_one(
     image: &Image<Rgb>,
     truth: &GroundTruth,
     power: [f64; 3],
-    method: Method,
+    method: ModelSpec,
     n: usize,
     options: &ExtractOptions,
 ) -> (Row, Option<LightSet>) {
     if !method.accepts(n) {
-        let reason = match method {
-            Method::MedianCut => format!("median cut makes a power of two lights; {n} is not one"),
+        let reason = match method.method() {
+            Some(Method::MedianCut) => {
+                format!("median cut makes a power of two lights; {n} is not one")
+            }
             _ => format!("{method} cannot make {n} lights"),
         };
         return (empty_row(method, n, Status::Skipped, Some(reason)), None);
     }
     let start = Instant::now();
     let result = catch_unwind(AssertUnwindSafe(|| {
-        ibl_extract::extract(image, method, n, options)
+        ibl_extract::build_model(image, method, n, options)
     }));
     let seconds = start.elapsed().as_secs_f64();
-    let extraction = match result {
+    let (model, parameters) = match result {
         Ok(Ok(x)) => x,
         Ok(Err(e)) => {
             return (
@@ -388,21 +379,18 @@ fn run_one(
             return (empty_row(method, n, Status::Failed, Some(reason)), None);
         }
     };
-    let parameters = extraction
-        .parameters
+    let approx = model.irradiance_many(&truth.normals);
+    let mut row = empty_row(method, n, Status::Ok, None);
+    row.lights = Some(model.lights().map_or(0, |set| set.lights.len()));
+    row.seconds = Some(seconds);
+    row.parameters = parameters
         .iter()
         .map(|(k, v)| (k.clone(), json_number(*v)))
         .collect();
-    let set = extraction.set;
-    let approx = light_set_irradiance(&set, &truth.normals);
-    let mut row = empty_row(method, n, Status::Ok, None);
-    row.lights = Some(set.lights.len());
-    row.seconds = Some(seconds);
-    row.parameters = parameters;
-    row.power_change_pct = power_change_pct(set.total_power(), power);
+    row.power_change_pct = power_change_pct(model.total_power(), power);
     if approx.iter().flatten().any(|v| !v.is_finite()) {
         row.status = Status::Failed;
-        row.reason = Some("the light set gives non-finite irradiance".to_string());
+        row.reason = Some("the model gives non-finite irradiance".to_string());
         return (row, None);
     }
     let err = truth.error_of(&approx);
@@ -410,7 +398,12 @@ fn run_one(
     row.max_err_pct = Some(err.max_err_pct);
     row.rel_mean_err_pct = Some(err.rel_mean_err_pct);
     row.rel_max_err_pct = Some(err.rel_max_err_pct);
-    (row, Some(set))
+    let set = match model {
+        Model::Lights(set) => Some(set),
+        Model::Hybrid(h) => Some(h.lights),
+        Model::Sh(_) => None,
+    };
+    (row, set)
 }
 
 /// Means over probes per method and N, where every probe has an `ok` row with every metric.
@@ -508,7 +501,10 @@ pub fn sweep(
                 });
                 let (row, set) = run_one(probe.image, &truth, power, method, n, &options.extract);
                 rows.push(row);
-                if let Some(set) = set.filter(|_| options.keep_sets_at == Some(n)) {
+                // Figures are of light sets alone: models with an SH part keep none.
+                let keep =
+                    options.keep_sets_at == Some(n) && matches!(method, ModelSpec::Lights(_));
+                if let Some(set) = set.filter(|_| keep) {
                     sets.push(KeptSet {
                         probe: index,
                         method,
@@ -536,11 +532,7 @@ pub fn sweep(
         probe: String::new(),
         stage: Stage::Finished,
     });
-    let methods: Vec<String> = options
-        .methods
-        .iter()
-        .map(|m| m.name().to_string())
-        .collect();
+    let methods: Vec<String> = options.methods.iter().map(|m| m.to_string()).collect();
     let averages = averages(&probe_reports, &methods, &options.counts);
     let report = Report {
         format: REPORT_FORMAT.to_string(),

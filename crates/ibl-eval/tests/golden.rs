@@ -20,7 +20,7 @@ use std::path::{Path, PathBuf};
 
 use ibl_core::{Image, Rgb};
 use ibl_eval::{ProbeInput, Status, SweepOptions, sweep};
-use ibl_extract::{ExtractOptions, Method};
+use ibl_extract::{ExtractOptions, Method, ModelSpec};
 use serde::{Deserialize, Serialize};
 
 const GOLDEN_FORMAT: &str = "iblkit.golden.extraction/1";
@@ -78,7 +78,7 @@ fn every_method_on_every_bundled_probe_matches_its_golden_numbers() {
         })
         .collect();
     let options = SweepOptions {
-        methods: Method::ALL.to_vec(),
+        methods: Method::ALL.map(ModelSpec::from).to_vec(),
         counts: vec![1, 4, 16, 64],
         normals: 20_000,
         extract: ExtractOptions::default(),

@@ -33,7 +33,7 @@ fn synthetic_probe() -> Image<Rgb> {
 
 fn options(counts: Vec<usize>, keep: Option<usize>) -> SweepOptions {
     SweepOptions {
-        methods: vec![Method::MedianCut],
+        methods: vec![Method::MedianCut.into()],
         counts,
         normals: 2000,
         extract: ExtractOptions::default(),
@@ -150,7 +150,10 @@ fn progress_counts_every_step_and_sets_are_kept_at_the_figure_n() {
     );
     assert!(seen.windows(2).all(|w| w[0].done <= w[1].done));
     assert_eq!(s.sets.len(), 1);
-    assert_eq!((s.sets[0].n, s.sets[0].method), (4, Method::MedianCut));
+    assert_eq!(
+        (s.sets[0].n, s.sets[0].method),
+        (4, Method::MedianCut.into())
+    );
     assert_eq!(s.sets[0].set.lights.len(), 4);
 }
 
