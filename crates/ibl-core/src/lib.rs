@@ -11,6 +11,7 @@ pub mod frame;
 pub mod image;
 pub mod irradiance;
 pub mod latlong;
+pub mod metrics;
 pub mod rgb;
 pub mod summed_area;
 
@@ -21,5 +22,6 @@ pub use glam;
 pub use image::Image;
 pub use irradiance::{RowIrradiance, channel_means, irradiance_exact, valid_radiance};
 pub use latlong::LatLong;
+pub use metrics::IrradianceError;
 pub use rgb::Rgb;
 pub use summed_area::SummedAreaTable;

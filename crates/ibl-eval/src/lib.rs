@@ -18,7 +18,6 @@
 //! Everything is f64 and deterministic: results are bit-identical whatever the rayon thread count.
 
 pub mod ground_truth;
-pub mod metrics;
 pub mod overlay;
 pub mod plot;
 pub mod report;
@@ -28,8 +27,10 @@ pub mod sweep;
 pub use ground_truth::{
     Emitters, FAST_DEFAULT_SIZE, GroundTruth, irradiance_brute_force, irradiance_fast,
 };
+pub use ibl_core::metrics::{
+    IrradianceError, max_err_pct, mean_err_pct, rel_max_err_pct, rel_mean_err_pct,
+};
 pub use ibl_core::{RowIrradiance, channel_means, irradiance_exact};
-pub use metrics::{IrradianceError, max_err_pct, mean_err_pct, rel_max_err_pct, rel_mean_err_pct};
 pub use plot::{ErrorChart, PLOT_SIZE, PlotError, render_png, render_svg};
 pub use report::{FigureFiles, LightsNeeded, PlotFiles, ReportFiles};
 pub use sphere_image::{SphereField, SphereFigure};

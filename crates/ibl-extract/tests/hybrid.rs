@@ -6,7 +6,8 @@
 
 use std::path::{Path, PathBuf};
 
-use ibl_core::{Image, LatLong, Rgb, channel_means, fibonacci_normals, irradiance_exact};
+use ibl_core::metrics::mean_err_pct;
+use ibl_core::{Image, LatLong, Rgb, fibonacci_normals, irradiance_exact};
 use ibl_extract::{ExtractOptions, Hybrid, Light, LightSet, Method, dominant_light, extract};
 use ibl_sh::{Window, project_latlong};
 
@@ -25,20 +26,6 @@ fn probes() -> Vec<(String, Image<Rgb>)> {
             (name, ibl_io::read_image(&p).unwrap().image)
         })
         .collect()
-}
-
-fn mean_err_pct(truth: &[[f64; 3]], approx: &[[f64; 3]]) -> f64 {
-    let mu = channel_means(truth);
-    let mut sum = 0.0;
-    for c in 0..3 {
-        sum += truth
-            .iter()
-            .zip(approx)
-            .map(|(g, e)| (e[c] - g[c]).abs())
-            .sum::<f64>()
-            / (truth.len() as f64 * mu[c]);
-    }
-    100.0 * sum / 3.0
 }
 
 fn probe_power(probe: &Image<Rgb>) -> [f64; 3] {

@@ -8,7 +8,7 @@ use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
 
 use ibl_core::glam::{DMat3, DVec3};
-use ibl_core::{Image, LatLong, Rgb, channel_means, fibonacci_normals, irradiance_exact};
+use ibl_core::{Image, IrradianceError, LatLong, Rgb, fibonacci_normals, irradiance_exact};
 use ibl_sh::{RadianceSh, Window, basis, lambert_factor, project_latlong, sh_index};
 
 /// A 512 x 256 lat-long probe with radiance `f(d)` at every pixel centre.
@@ -162,22 +162,8 @@ fn probes() -> Vec<(String, Image<Rgb>)> {
 
 /// (mean_err%, max_err%) of CONVENTIONS section 5.
 fn errors(truth: &[[f64; 3]], approx: &[[f64; 3]]) -> (f64, f64) {
-    let mu = channel_means(truth);
-    let (mut mean, mut max, mut channels) = (0.0, 0.0, 0.0);
-    for c in 0..3 {
-        if mu[c] <= 0.0 {
-            continue;
-        }
-        let d: Vec<f64> = truth
-            .iter()
-            .zip(approx)
-            .map(|(g, e)| (e[c] - g[c]).abs() / mu[c])
-            .collect();
-        mean += d.iter().sum::<f64>() / d.len() as f64;
-        max += d.iter().copied().fold(0.0, f64::max);
-        channels += 1.0;
-    }
-    (100.0 * mean / channels, 100.0 * max / channels)
+    let e = IrradianceError::between(truth, approx);
+    (e.mean_err_pct, e.max_err_pct)
 }
 
 /// SH irradiance against the exact ground truth on the bundled probes: 3 bands ("SH9") lands at a
