@@ -41,6 +41,8 @@ enum Command {
     Irradiance(cmd::irradiance::IrradianceArgs),
     /// Approximate a lat-long probe by N directional lights; write JSON, glTF, Mitsuba or pbrt.
     Lights(cmd::lights::LightsArgs),
+    /// Spherical-harmonic lighting of a probe, in iblkit's JSON or another tool's convention.
+    Sh(cmd::sh::ShArgs),
     /// Compare the light extraction methods on probes: error vs N, plots, spheres, report.
     Eval(cmd::eval::EvalArgs),
     /// Write a tone-mapped 8-bit preview (PNG or JPEG) of an HDR image.
@@ -67,6 +69,7 @@ fn main() -> ExitCode {
         Command::Convert(args) => cmd::convert::run(&args),
         Command::Irradiance(args) => cmd::irradiance::run(&args),
         Command::Lights(args) => cmd::lights::run(&args),
+        Command::Sh(args) => cmd::sh::run(&args),
         Command::Eval(args) => cmd::eval::run(&args),
         Command::Preview(args) => cmd::preview::run(&args),
         Command::Demo(args) => cmd::demo::run(&args),

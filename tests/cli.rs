@@ -214,7 +214,16 @@ fn missing_files_and_bad_arguments_exit_2() {
 
 #[test]
 fn every_help_has_examples() {
-    for cmd in ["info", "convert", "preview", "demo", "lights", "irradiance"] {
+    for cmd in [
+        "info",
+        "convert",
+        "preview",
+        "demo",
+        "lights",
+        "irradiance",
+        "eval",
+        "sh",
+    ] {
         let out = ibl(&[cmd, "--help"]);
         assert!(out.status.success());
         assert!(

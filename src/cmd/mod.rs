@@ -7,3 +7,4 @@ pub mod info;
 pub mod irradiance;
 pub mod lights;
 pub mod preview;
+pub mod sh;

@@ -26,6 +26,7 @@ pub mod light_export;
 pub mod light_file;
 pub mod pfm;
 pub mod sanitize;
+pub mod sh_file;
 pub mod tonemap;
 
 use std::io::Write;
@@ -38,6 +39,7 @@ pub use exr::{ExrCompression, ExrOptions, ExrPrecision};
 pub use format::{ImageFormat, Limits, RawImage};
 pub use light_export::{ExportError, ExportOptions, LightFormat, write_light_file};
 pub use sanitize::{SanitizeReport, sanitize};
+pub use sh_file::{ShFile, ShFileFormat, ShQuantity, read_sh_file, write_sh_file};
 pub use tonemap::{Display, ToneCurve};
 
 use tonemap::to_srgb8;
