@@ -485,3 +485,66 @@ fn outputs_naming_the_input_are_refused_and_the_input_kept() {
         assert_eq!(std::fs::read(&exr).unwrap(), before);
     }
 }
+
+#[test]
+fn hybrid_lights_carry_an_sh_ambient_in_json() {
+    use ibl_core::glam::DVec3;
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("hybrid.json");
+    let sky = probe("sky.exr");
+    let o = ibl(&[
+        "lights",
+        &sky,
+        "-n",
+        "1",
+        "--method",
+        "irradiance-optimization",
+        "--ambient-sh",
+        "3",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let file = ibl_io::light_file::read_lights_file(&out).unwrap();
+    let ambient = file.ambient.as_ref().unwrap();
+    assert_eq!((ambient.bands, ambient.radiance.len()), (3, 9));
+    let sh = ibl_sh::RadianceSh::new(3, ambient.radiance.clone())
+        .unwrap()
+        .irradiance(ibl_sh::Window::None);
+    // Lights + ambient against the exact irradiance: 1 light + SH9 is within a few per cent.
+    let image = ibl_io::read_image(std::path::Path::new(&sky))
+        .unwrap()
+        .image;
+    let normals = ibl_core::fibonacci_normals(2000);
+    let truth = ibl_core::irradiance_exact(&image, &normals);
+    let approx: Vec<[f64; 3]> = normals
+        .iter()
+        .map(|n| {
+            let a = sh.irradiance(*n);
+            let mut e = a;
+            for l in &file.lights {
+                let c = n.dot(DVec3::from_array(l.direction)).max(0.0);
+                for ch in 0..3 {
+                    e[ch] += l.irradiance[ch] * c;
+                }
+            }
+            e
+        })
+        .collect();
+    let err = ibl_core::IrradianceError::between(&truth, &approx);
+    assert!(err.mean_err_pct < 3.0, "{err:?}");
+    // Only JSON has a place for the ambient.
+    let gltf = dir.path().join("h.gltf");
+    let r = ibl(&[
+        "lights",
+        &sky,
+        "-n",
+        "1",
+        "--ambient-sh",
+        "3",
+        "-o",
+        gltf.to_str().unwrap(),
+    ]);
+    assert_eq!(r.status.code(), Some(2));
+    assert!(!gltf.exists());
+}

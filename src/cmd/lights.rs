@@ -17,7 +17,7 @@ use ibl_core::rgb::Rgb64;
 use ibl_extract::{ExtractOptions, LightSet, Method};
 use ibl_io::LightFormat;
 use ibl_io::light_file::{
-    LIGHTS_FORMAT, LightRecord, LightsFile, MethodRef, ProbeRef, RegionRecord,
+    AmbientRecord, LIGHTS_FORMAT, LightRecord, LightsFile, MethodRef, ProbeRef, RegionRecord,
 };
 use ibl_mapping::Mapping;
 
@@ -64,6 +64,9 @@ The format of each -o file follows its extension:
   .gltf, .glb   glTF 2.0 with KHR_lights_punctual directional lights (intensity in lux)
   .xml          Mitsuba 3 scene with one directional emitter per light (irradiance I)
   .pbrt         pbrt-v4 fragment with one distant light per light (rgb L = I)
+With --ambient-sh B the light set becomes hybrid lighting: the lights plus an SH ambient of B
+bands carrying the rest of the probe (total power conserved), written into the .json file
+(`ambient`); the other formats have no place for it (use `ibl sh` for the probe's SH).
 Directions are written in the --frame preset's axes in every format (glTF itself is defined in
 the gltf frame). The overlay is drawn on the probe as stored, whatever the frame.
 
@@ -72,7 +75,8 @@ Examples:
   ibl lights probe.hdr -n 64 -o lights.gltf --overlay lights.png
   ibl lights probe.exr -n 12 --method adaptive-median-cut -o scene.xml -o scene.pbrt
   ibl lights probe.exr -n 8 --method lightgen --seed 7 -o sun.glb --lux-per-unit 20
-  ibl lights probe.hdr -n 32 -o lights.json --frame blender --json"
+  ibl lights probe.hdr -n 32 -o lights.json --frame blender --json
+  ibl lights sky.exr -n 1 --method irradiance-optimization --ambient-sh 3 -o sun+sh9.json"
 )]
 pub struct LightsArgs {
     /// Lat-long probe (.exr, .hdr, .pfm).
@@ -102,6 +106,10 @@ pub struct LightsArgs {
     /// direction marked (bigger markers for stronger lights), enlarged to at least 1024 pixels wide.
     #[arg(long, value_name = "FILE.png")]
     pub overlay: Option<PathBuf>,
+    /// Hybrid lighting: add an SH ambient of this many bands (3 = SH9) that carries the rest of
+    /// the probe; written to .json outputs only.
+    #[arg(long, value_name = "B")]
+    pub ambient_sh: Option<usize>,
     /// Print a JSON summary (method, lights made and asked, seconds, power, outputs) on stdout
     /// instead of text.
     #[arg(long)]
@@ -152,6 +160,22 @@ fn check_args(args: &LightsArgs) -> anyhow::Result<Vec<Output<'_>>> {
             Ok(Output { path, format })
         })
         .collect::<anyhow::Result<Vec<_>>>()?;
+    if let Some(bands) = args.ambient_sh {
+        if bands == 0 || bands > ibl_sh::MAX_BANDS {
+            return Err(usage(format!(
+                "--ambient-sh must be between 1 and {}",
+                ibl_sh::MAX_BANDS
+            )));
+        }
+        if let Some(o) = outputs.iter().find(|o| o.format != LightFormat::Json) {
+            return Err(usage(format!(
+                "{}: {} has no place for an SH ambient; write the hybrid to a .json file \
+                 (and the probe's SH with `ibl sh --format ...`)",
+                o.path.display(),
+                o.format.name()
+            )));
+        }
+    }
     if let Some(overlay) = &args.overlay
         && !matches!(
             ibl_io::ImageFormat::from_path(overlay),
@@ -245,6 +269,23 @@ pub fn run(args: &LightsArgs) -> anyhow::Result<()> {
     }
 
     let m = frame.preset_from_world().as_dmat3();
+    let ambient = match args.ambient_sh {
+        Some(bands) => {
+            let hybrid = ibl_extract::Hybrid::from_probe(
+                &env.image,
+                set.clone(),
+                bands,
+                ibl_sh::Window::None,
+            )
+            .map_err(|e| usage(format!("{}: {e}", args.probe.display())))?;
+            Some(AmbientRecord {
+                convention: ibl_io::sh_file::SH_CONVENTION.to_string(),
+                bands,
+                radiance: hybrid.ambient.transformed(m).coefficients().to_vec(),
+            })
+        }
+        None => None,
+    };
     let file = LightsFile {
         format: LIGHTS_FORMAT.to_string(),
         probe: ProbeRef {
@@ -274,6 +315,7 @@ pub fn run(args: &LightsArgs) -> anyhow::Result<()> {
                 }),
             })
             .collect(),
+        ambient,
     };
     for o in &outputs {
         ibl_io::write_light_file(o.path, &file, args.lux_per_unit)?;
@@ -314,6 +356,7 @@ pub fn run(args: &LightsArgs) -> anyhow::Result<()> {
             "total_power": set.total_power(),
             "probe_power": probe_power,
             "parameters": file.method.parameters,
+            "ambient_sh_bands": args.ambient_sh,
             "outputs": args.output.iter().map(|p| p.display().to_string()).collect::<Vec<_>>(),
             "overlay": args.overlay.as_ref().map(|p| p.display().to_string()),
         });

@@ -834,6 +834,7 @@ mod tests {
                 parameters: json!({ "splits": 3 }),
             },
             lights: sample_lights(),
+            ambient: None,
         };
         let dir = tempfile::tempdir().expect("tempdir");
         let a = dir.path().join("a.json");

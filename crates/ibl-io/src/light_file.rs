@@ -82,6 +82,22 @@ pub struct LightsFile {
     pub method: MethodRef,
     /// The lights.
     pub lights: Vec<LightRecord>,
+    /// Hybrid lighting: the SH ambient that carries the rest of the probe (radiance
+    /// coefficients in the file's `frame`; the lights' irradiance plus the ambient's gives the
+    /// probe's).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ambient: Option<AmbientRecord>,
+}
+
+/// The SH ambient of a hybrid light set.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AmbientRecord {
+    /// The basis (see [`crate::sh_file::SH_CONVENTION`]).
+    pub convention: String,
+    /// Number of bands (`coefficients` has `bands^2` entries).
+    pub bands: usize,
+    /// Radiance coefficients `[l*l + l + m]`, linear RGB.
+    pub radiance: Vec<[f64; 3]>,
 }
 
 /// SHA-256 of a file, lower-case hex. Streams the file (O(1) memory).

@@ -113,6 +113,23 @@ macro_rules! shared_methods {
                 }
             }
 
+            /// The same function seen through any orthogonal matrix `m` (new directions `m d`): a
+            /// rotation as [`Self::rotated`], a reflection (determinant -1, such as a change to a
+            /// left-handed frame) as the rotation `-m` followed by the inversion `d -> -d`, which
+            /// multiplies band `l` by `(-1)^l`. O(bands^3).
+            pub fn transformed(&self, m: DMat3) -> Self {
+                if m.determinant() > 0.0 {
+                    return self.rotated(m);
+                }
+                let mut out = self.rotated(-m);
+                for l in (1..self.bands).step_by(2) {
+                    for c in &mut out.coeffs[l * l..(l + 1) * (l + 1)] {
+                        *c = c.map(|v| -v);
+                    }
+                }
+                out
+            }
+
             /// The first `bands` bands (all of them if there are fewer).
             pub fn truncated(&self, bands: usize) -> Self {
                 let bands = bands.clamp(1, self.bands);

@@ -119,6 +119,21 @@ fn rotation_keeps_band_energy_and_commutes_with_rotating_the_probe() {
 }
 
 #[test]
+fn reflections_mirror_the_function() {
+    // A mirror in x (a change of handedness): L'(d) = L(M^-1 d) with M = diag(-1, 1, 1).
+    let axis = DVec3::new(0.6, 0.2, -0.3).normalize();
+    let sh = project_latlong(&synthetic(|d| smooth(d, axis)), 9).unwrap();
+    let m = DMat3::from_diagonal(DVec3::new(-1.0, 1.0, 1.0));
+    let mirrored = sh.transformed(m);
+    for d in fibonacci_normals(50) {
+        let (a, b) = (mirrored.radiance(d), sh.radiance(m * d));
+        for c in 0..3 {
+            assert!((a[c] - b[c]).abs() < 1e-9 * (1.0 + b[c].abs()), "{d}");
+        }
+    }
+}
+
+#[test]
 fn reconstruction_converges_as_bands_grow() {
     let axis = DVec3::new(-0.4, 0.5, 0.7).normalize();
     let probe = synthetic(|d| smooth(d, axis));
