@@ -524,8 +524,8 @@ fn hybrid_lights_carry_an_sh_ambient_in_json() {
             let mut e = a;
             for l in &file.lights {
                 let c = n.dot(DVec3::from_array(l.direction)).max(0.0);
-                for ch in 0..3 {
-                    e[ch] += l.irradiance[ch] * c;
+                for (v, i) in e.iter_mut().zip(l.irradiance) {
+                    *v += i * c;
                 }
             }
             e
