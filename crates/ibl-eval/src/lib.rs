@@ -35,5 +35,6 @@ pub use plot::{ErrorChart, PLOT_SIZE, PlotError, render_png, render_svg};
 pub use report::{FigureFiles, LightsNeeded, PlotFiles, ReportFiles};
 pub use sphere_image::{SphereField, SphereFigure};
 pub use sweep::{
-    ProbeInput, REPORT_FORMAT, Report, Row, Status, Sweep, SweepOptions, SweepProgress, sweep,
+    FastPathRow, ProbeInput, REPORT_FORMAT, Report, Row, Status, Sweep, SweepOptions,
+    SweepProgress, fast_paths, sweep,
 };

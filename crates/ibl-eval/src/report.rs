@@ -12,7 +12,7 @@ use std::fmt::Write as _;
 
 use serde::{Deserialize, Serialize};
 
-use crate::sweep::{AverageRow, Report, Row, Status};
+use crate::sweep::{AverageRow, FastPathRow, Report, Row, Status};
 
 /// The header line of `report.csv`.
 pub const CSV_HEADER: &str = "probe,method,n,lights,mean_err_pct,max_err_pct,rel_mean_err_pct,rel_max_err_pct,seconds,status";
@@ -295,6 +295,43 @@ fn write_averages_at(out: &mut String, report: &Report) {
     out.push('\n');
 }
 
+/// Writes the fast irradiance paths (block reduction, SH) averaged over the probes.
+fn write_fast_paths(out: &mut String, report: &Report) {
+    let Some(first) = report.probes.first() else {
+        return;
+    };
+    let _ = writeln!(
+        out,
+        "## Fast irradiance paths against the exact ground truth\n\n\
+         No lights: the probe reduced to energy-conserving blocks, or its spherical harmonics \
+         Lambert-convolved (`shB` = B bands; sh3 is the usual 9 coefficients). Mean over the \
+         probes.\n\n\
+         | path | mean_err % | max_err % | seconds |\n\
+         |---|---:|---:|---:|"
+    );
+    for (i, path) in first.fast_paths.iter().enumerate() {
+        let rows: Vec<&FastPathRow> = report
+            .probes
+            .iter()
+            .filter_map(|p| p.fast_paths.get(i).filter(|r| r.name == path.name))
+            .collect();
+        if rows.len() != report.probes.len() {
+            continue;
+        }
+        let k = rows.len() as f64;
+        let mean = |f: fn(&FastPathRow) -> f64| rows.iter().map(|r| f(r)).sum::<f64>() / k;
+        let _ = writeln!(
+            out,
+            "| {} | {} | {} | {:.4} |",
+            path.name,
+            pct(Some(mean(|r| r.mean_err_pct))),
+            pct(Some(mean(|r| r.max_err_pct))),
+            mean(|r| r.seconds)
+        );
+    }
+    out.push('\n');
+}
+
 /// Writes the rows that did not run, grouped by method, N and reason.
 fn write_not_ok(out: &mut String, report: &Report) {
     // (method, n, status, reason) -> probes
@@ -492,6 +529,7 @@ pub fn markdown(report: &Report) -> String {
     );
     write_needed(&mut out, report);
     write_averages_at(&mut out, report);
+    write_fast_paths(&mut out, report);
     write_not_ok(&mut out, report);
     write_checks(&mut out, report);
     write_files(&mut out, report);

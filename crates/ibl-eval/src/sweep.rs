@@ -171,6 +171,55 @@ pub struct ProbeReport {
     pub power: [f64; 3],
     /// One row per method and N, methods in sweep order, N in sweep order within a method.
     pub rows: Vec<Row>,
+    /// The fast irradiance paths (no lights) against the exact ground truth on the same normals.
+    #[serde(default)]
+    pub fast_paths: Vec<FastPathRow>,
+}
+
+/// A fast approximation of the irradiance, scored like a method (see [`fast_paths`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FastPathRow {
+    /// `blocks-64x32` (the probe reduced to energy-conserving blocks) or `sh<B>` (Lambert-convolved
+    /// spherical harmonics of B bands).
+    pub name: String,
+    /// `mean_err%` against the exact ground truth.
+    pub mean_err_pct: f64,
+    /// `max_err%` against the exact ground truth.
+    pub max_err_pct: f64,
+    /// Wall-clock seconds (projection or reduction included).
+    pub seconds: f64,
+}
+
+/// SH band counts scored as fast paths.
+pub const FAST_PATH_SH_BANDS: [usize; 3] = [3, 9, 21];
+
+/// The fast irradiance paths on one probe: the 64 x 32 block reduction and SH of
+/// [`FAST_PATH_SH_BANDS`] bands, each scored against the exact ground truth.
+pub fn fast_paths(image: &Image<Rgb>, truth: &GroundTruth) -> Vec<FastPathRow> {
+    let row = |name: String, start: Instant, approx: Vec<[f64; 3]>| {
+        let seconds = start.elapsed().as_secs_f64();
+        let err = truth.error_of(&approx);
+        FastPathRow {
+            name,
+            mean_err_pct: err.mean_err_pct,
+            max_err_pct: err.max_err_pct,
+            seconds,
+        }
+    };
+    let start = Instant::now();
+    let blocks = crate::irradiance_fast(image, &truth.normals, crate::FAST_DEFAULT_SIZE);
+    let (bw, bh) = crate::FAST_DEFAULT_SIZE;
+    let mut rows = vec![row(format!("blocks-{bw}x{bh}"), start, blocks)];
+    for bands in FAST_PATH_SH_BANDS {
+        let start = Instant::now();
+        if let Ok(sh) = ibl_sh::project_latlong(image, bands) {
+            let approx = sh
+                .irradiance(ibl_sh::Window::None)
+                .eval_many(&truth.normals);
+            rows.push(row(format!("sh{bands}"), start, approx));
+        }
+    }
+    rows
 }
 
 /// The mean over probes of one method at one N (only where every probe has an `ok` row).
@@ -524,6 +573,7 @@ pub fn sweep(
             mean_irradiance: truth.mean,
             power,
             rows,
+            fast_paths: fast_paths(probe.image, &truth),
         });
     }
     progress(SweepProgress {

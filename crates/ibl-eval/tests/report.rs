@@ -275,3 +275,22 @@ fn unusable_options_are_refused() {
     assert!(sweep(&[input], &options(vec![0], None), &|_| {}).is_err());
     assert!(sweep(&[], &options(vec![1], None), &|_| {}).is_err());
 }
+
+#[test]
+fn fast_paths_are_scored_against_the_ground_truth() {
+    let (s, _) = run_synthetic();
+    let paths = &s.report.probes[0].fast_paths;
+    let names: Vec<&str> = paths.iter().map(|p| p.name.as_str()).collect();
+    assert_eq!(names, ["blocks-64x32", "sh3", "sh9", "sh21"]);
+    // More bands, less error; every path is scored with finite numbers.
+    assert!(paths[1].mean_err_pct > paths[2].mean_err_pct);
+    assert!(paths[2].mean_err_pct > paths[3].mean_err_pct);
+    assert!(
+        paths
+            .iter()
+            .all(|p| p.max_err_pct.is_finite() && p.seconds >= 0.0)
+    );
+    let md = ibl_eval::report::markdown(&s.report);
+    assert!(md.contains("## Fast irradiance paths against the exact ground truth"));
+    assert!(md.contains("| sh3 |"));
+}
