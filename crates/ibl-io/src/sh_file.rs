@@ -105,17 +105,7 @@ impl ShFileFormat {
             15f64.sqrt() / (2.0 * root),
             15f64.sqrt() / (4.0 * root),
         ];
-        let a = [
-            pi,
-            2.0 * pi / 3.0,
-            2.0 * pi / 3.0,
-            2.0 * pi / 3.0,
-            pi / 4.0,
-            pi / 4.0,
-            pi / 4.0,
-            pi / 4.0,
-            pi / 4.0,
-        ];
+        let a = lambert_factors();
         let cs = [1.0, -1.0, 1.0, -1.0, 1.0, -1.0, 1.0, -1.0, 1.0];
         let z_flip = [1.0, 1.0, -1.0, 1.0, 1.0, -1.0, 1.0, -1.0, 1.0];
         std::array::from_fn(|i| match self {
@@ -126,6 +116,17 @@ impl ShFileFormat {
             ShFileFormat::GltfExt => cs[i] * a[i],
         })
     }
+}
+
+/// The Lambert factor `A_l` of each of the first nine coefficients (`pi`, `2 pi / 3` x3, `pi / 4`
+/// x5).
+fn lambert_factors() -> [f64; 9] {
+    let pi = std::f64::consts::PI;
+    std::array::from_fn(|i| match i {
+        0 => pi,
+        1..=3 => 2.0 * pi / 3.0,
+        _ => pi / 4.0,
+    })
 }
 
 /// Whether coefficients hold radiance or irradiance (iblkit's JSON only).
@@ -487,7 +488,6 @@ mod tests {
 
     /// iblkit's irradiance `E(n) = sum_i A_l c_i k_i P_i(n)` from its radiance coefficients.
     fn iblkit_irradiance(c: &[[f64; 3]], n: [f64; 3], ch: usize) -> f64 {
-        let pi = std::f64::consts::PI;
         let [x, y, z] = n;
         let basis = [
             0.282095,
@@ -500,17 +500,7 @@ mod tests {
             1.092548 * x * z,
             0.546274 * (x * x - y * y),
         ];
-        let a = [
-            pi,
-            2.0 * pi / 3.0,
-            2.0 * pi / 3.0,
-            2.0 * pi / 3.0,
-            pi / 4.0,
-            pi / 4.0,
-            pi / 4.0,
-            pi / 4.0,
-            pi / 4.0,
-        ];
+        let a = lambert_factors();
         (0..9).map(|i| a[i] * c[i][ch] * basis[i]).sum()
     }
 
@@ -553,17 +543,7 @@ mod tests {
             0.546274,
         ];
         let s = [1.0, -1.0, 1.0, -1.0, 1.0, -1.0, 1.0, -1.0, 1.0];
-        let a = [
-            pi,
-            2.0 * pi / 3.0,
-            2.0 * pi / 3.0,
-            2.0 * pi / 3.0,
-            pi / 4.0,
-            pi / 4.0,
-            pi / 4.0,
-            pi / 4.0,
-            pi / 4.0,
-        ];
+        let a = lambert_factors();
         for n in [
             [0.0, 1.0, 0.0],
             [0.6, 0.0, -0.8],
