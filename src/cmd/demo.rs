@@ -2,8 +2,10 @@
 //!
 //! It describes every bundled probe, writes a tone-mapped preview, shows each probe in every
 //! mapping (EXR plus preview), converts each back to lat-long and reports how much power the round
-//! trip kept. Then it runs the comparison of `ibl eval` on the same probes (every extraction
-//! method, N = 1 to 128, 20000 scoring normals) into `eval/`. Everything lands in one folder with
+//! trip kept, and writes its irradiance map exact and as SH9 with SH9's error and the probe's
+//! dominant light. Then it runs the comparison of `ibl eval` on the same probes (every extraction
+//! method, SH9 alone and LightGen lights with an SH9 ambient, N = 1 to 128, 20000 scoring normals)
+//! into `eval/`. Everything lands in one folder with
 //! an `index.html` to look at and a `summary.json` for scripts.
 
 use std::fmt::Write as _;
@@ -45,6 +47,19 @@ pub struct DemoArgs {
 /// 15 s per probe for all of 1 to 128.
 const DEMO_EVAL_COUNTS: [usize; 8] = [1, 2, 4, 8, 16, 32, 64, 128];
 
+/// The demo's comparison: every light method, SH9 alone and LightGen lights with an SH9 ambient.
+fn demo_methods() -> Vec<ibl_extract::ModelSpec> {
+    let mut methods: Vec<ibl_extract::ModelSpec> = ibl_extract::Method::ALL
+        .map(ibl_extract::ModelSpec::from)
+        .to_vec();
+    methods.push(ibl_extract::ModelSpec::Sh { bands: 3 });
+    methods.push(ibl_extract::ModelSpec::Hybrid {
+        lights: ibl_extract::LightSource::Method(ibl_extract::Method::LightGen),
+        bands: 3,
+    });
+    methods
+}
+
 /// The mappings the demo shows each probe in, with their file stems.
 fn demo_mappings() -> Vec<(&'static str, MappingArg)> {
     vec![
@@ -85,6 +100,19 @@ struct MappingResult {
     round_trip_power_change_pct: Option<f64>,
 }
 
+/// A probe's irradiance maps (exact and SH9) and its dominant light.
+#[derive(Serialize)]
+struct IrradianceResult {
+    exact_preview: String,
+    sh9_preview: String,
+    /// SH9 against the exact ground truth on 20000 normals, per cent of the mean irradiance.
+    sh9_mean_err_pct: f64,
+    sh9_max_err_pct: f64,
+    /// The dominant light (CONVENTIONS frame) and the confidence that it is one compact source.
+    sun_direction: [f64; 3],
+    sun_confidence: f64,
+}
+
 /// One probe in the summary.
 #[derive(Serialize)]
 struct ProbeResult {
@@ -92,6 +120,7 @@ struct ProbeResult {
     info: info::Info,
     preview: String,
     mappings: Vec<MappingResult>,
+    irradiance: IrradianceResult,
 }
 
 /// Finds the bundled probes: `assets/probes` beside the binary's source tree, else in the
@@ -144,7 +173,8 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("{}: cannot create output folder", args.out.display()))?;
     let mappings = demo_mappings();
-    let bar = progress::bar("demo", (probes.len() * (mappings.len() + 1)) as u64);
+    // Per probe: the preview, each mapping, the irradiance maps.
+    let bar = progress::bar("demo", (probes.len() * (mappings.len() + 2)) as u64);
     let mut results = Vec::new();
     for path in &probes {
         let name = path
@@ -158,9 +188,7 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
     }
     bar.finish_and_clear();
     let settings = eval::EvalSettings::new(
-        ibl_extract::Method::ALL
-            .map(ibl_extract::ModelSpec::from)
-            .to_vec(),
+        demo_methods(),
         DEMO_EVAL_COUNTS.to_vec(),
         ibl_core::fibonacci::DEFAULT_NORMAL_COUNT,
         ibl_extract::ExtractOptions::default().seed,
@@ -255,11 +283,76 @@ fn demo_probe(
         });
         bar.inc(1);
     }
+    let irradiance = demo_irradiance(&env.image, &dir, out, path)?;
+    bar.inc(1);
     Ok(ProbeResult {
         name: name.to_string(),
         info,
         preview: relative(out, &preview),
         mappings: results,
+        irradiance,
+    })
+}
+
+/// Width of the demo's irradiance maps (irradiance is smooth).
+const IRRADIANCE_MAP_WIDTH: usize = 256;
+
+/// The exact and SH9 irradiance maps of a probe (EXR and a preview each, both previews at the
+/// exact map's exposure so they compare), SH9's error and the dominant light.
+fn demo_irradiance(
+    image: &ibl_core::Image<ibl_core::Rgb>,
+    dir: &Path,
+    out: &Path,
+    input: &Path,
+) -> anyhow::Result<IrradianceResult> {
+    let (w, h) = Mapping::LatLong.size_for_width(IRRADIANCE_MAP_WIDTH);
+    let ll = ibl_core::LatLong::new(w, h);
+    let dirs: Vec<ibl_core::glam::DVec3> = (0..h)
+        .flat_map(|j| (0..w).map(move |i| (i, j)))
+        .map(|(i, j)| ll.pixel_dir64(i, j))
+        .collect();
+    let sh9 = ibl_sh::project_latlong(image, 3)?.irradiance(ibl_sh::Window::None);
+    let to_image = |e: Vec<[f64; 3]>| {
+        let mut img = ibl_core::Image::filled(w, h, ibl_core::Rgb::ZERO);
+        for (k, v) in e.into_iter().enumerate() {
+            *img.get_mut(k % w, k / w) = ibl_core::Rgb::new(v[0] as f32, v[1] as f32, v[2] as f32);
+        }
+        img
+    };
+    let exact = to_image(ibl_core::RowIrradiance::new(image).irradiance(&dirs));
+    let approx = to_image(sh9.eval_many(&dirs));
+    let display = Display {
+        exposure_stops: ibl_io::tonemap::auto_exposure_stops(&exact),
+        curve: ToneCurve::Reinhard,
+    };
+    let preview_opts = WriteOptions {
+        display,
+        ..Default::default()
+    };
+    let mut previews = Vec::new();
+    for (stem, img) in [("irradiance-exact", &exact), ("irradiance-sh9", &approx)] {
+        envmap_files::save(
+            &dir.join(format!("{stem}.exr")),
+            img,
+            MappingArg::Single(Mapping::LatLong),
+            &WriteOptions::default(),
+            &[input],
+        )?;
+        let p = dir.join(format!("{stem}.png"));
+        ibl_io::write_image(&p, img, &preview_opts)?;
+        previews.push(relative(out, &p));
+    }
+    let normals = ibl_core::fibonacci_normals(ibl_core::fibonacci::DEFAULT_NORMAL_COUNT);
+    let truth = ibl_core::irradiance_exact(image, &normals);
+    let err = ibl_core::IrradianceError::between(&truth, &sh9.eval_many(&normals));
+    let sun = ibl_extract::dominant_light(image)?;
+    Ok(IrradianceResult {
+        exact_preview: previews[0].clone(),
+        sh9_preview: previews[1].clone(),
+        sh9_mean_err_pct: err.mean_err_pct,
+        sh9_max_err_pct: err.max_err_pct,
+        sun_direction: sun.direction,
+        sun_confidence: sun.confidence,
     })
 }
 
@@ -377,6 +470,18 @@ fn write_summary(
             html,
             "<figure><img src=\"{}\"><figcaption>latlong</figcaption></figure>",
             r.preview
+        );
+        let irr = &r.irradiance;
+        let _ = write!(
+            html,
+            "<figure><img src=\"{}\"><figcaption>irradiance, exact</figcaption></figure>\
+             <figure><img src=\"{}\"><figcaption>irradiance, SH9 (mean {:.2} %, max {:.1} %; \
+             sun confidence {:.2})</figcaption></figure>",
+            irr.exact_preview,
+            irr.sh9_preview,
+            irr.sh9_mean_err_pct,
+            irr.sh9_max_err_pct,
+            irr.sun_confidence
         );
         for m in &r.mappings {
             let change = m
