@@ -316,7 +316,11 @@ fn demo_writes_every_mapping_and_an_index() {
     // Irradiance maps: exact and SH9, with SH9's error (a few per cent) and the sun's confidence.
     for p in probes {
         let irr = &p["irradiance"];
-        assert!(out_dir.join(irr["exact_preview"].as_str().unwrap()).exists());
+        assert!(
+            out_dir
+                .join(irr["exact_preview"].as_str().unwrap())
+                .exists()
+        );
         assert!(out_dir.join(irr["sh9_preview"].as_str().unwrap()).exists());
         let err = irr["sh9_mean_err_pct"].as_f64().unwrap();
         assert!(err > 0.1 && err < 10.0, "{}: {err}", p["name"]);

@@ -412,6 +412,19 @@ fn write_checks(out: &mut String, report: &Report) {
         })
         .map(|(p, r)| format!("{} N = {} on {}", r.method, r.n, p.name))
         .collect();
+    let fitted = report
+        .probes
+        .iter()
+        .flat_map(|p| p.rows.iter())
+        .filter(|r| r.parameters.contains_key("converged"))
+        .count();
+    if fitted > 0 {
+        let _ = writeln!(
+            out,
+            "- Fitted runs that met their convergence test: {} of {fitted}.",
+            fitted - unconverged.len()
+        );
+    }
     if !unconverged.is_empty() {
         let _ = writeln!(
             out,

@@ -294,3 +294,21 @@ fn fast_paths_are_scored_against_the_ground_truth() {
     assert!(md.contains("## Fast irradiance paths against the exact ground truth"));
     assert!(md.contains("| sh3 |"));
 }
+
+#[test]
+fn markdown_counts_converged_fits() {
+    let probe = synthetic_probe();
+    let input = ProbeInput {
+        name: "synthetic",
+        sha256: "00",
+        image: &probe,
+    };
+    let mut o = options(vec![1, 2], None);
+    o.methods = vec![Method::IrradianceOptimization.into()];
+    let s = sweep(&[input], &o, &|_| {}).unwrap();
+    let md = ibl_eval::report::markdown(&s.report);
+    assert!(
+        md.contains("- Fitted runs that met their convergence test: 2 of 2."),
+        "{md}"
+    );
+}
