@@ -50,9 +50,9 @@
 //! The Jacobian has structure: with the light's features `c = n.w`, `a = n.t1`, `b = n.t2` (zero
 //! where `n.w <= 0`) gathered in an M x 3N matrix `Phi`, every block of `J^T J` is a per-channel
 //! weight times an entry of the Gram matrix `Phi^T Phi`, and the fitting normals are spread
-//! evenly over the sphere, so that Gram matrix is taken in closed form ([`crate::lune_gram`]:
+//! evenly over the sphere, so that Gram matrix is taken in closed form (module `lune_gram`:
 //! O(N^2), independent of M). It only chooses the step: the cost and the gradient are exact sums
-//! over the normals (O(M N), in vector lanes: [`crate::normal_lanes`]), so a step is kept only if
+//! over the normals (O(M N), in vector lanes: module `normal_lanes`), so a step is kept only if
 //! it truly lowers the cost. (Against the exact `Phi^T Phi`, at twice the time, the fits end no
 //! better.) The Cholesky solve costs O((5N)^3). Results are bit-identical whatever the thread
 //! count.

@@ -12,7 +12,7 @@
 //! | `unity` | `F_i z_i c_i` | 27 floats, channel-major (`[rgb * 9 + i]`) | Unity `SphericalHarmonicsL2.bindings.cs` (indexer), SRP core `SphericalHarmonics.hlsl` (`SHEvalLinearL0L1`, `PackSH`) |
 //! | `webxr` | `c_i` | 27 floats, RGB per coefficient | W3C Lighting Estimation `sphericalHarmonicsCoefficients`; three.js `XREstimatedLight.js` reads it as `SphericalHarmonics3` |
 //! | `arkit` | `s_i c_i` | 27 floats, channel-major | Apple `ARDirectionalLightEstimate.sphericalHarmonicsCoefficients` (layout); signs: Unity's ARKit plugin (`ARLightEstimate.cs`) |
-//! | `gltf-ext` | `s_i A_l c_i` | `EXT_lights_image_based` light, `irradianceCoefficients` 9 x [r,g,b] | KhronosGroup glTF `EXT_lights_image_based` README; basis as Babylon.js's loader reads it |
+//! | `gltf-ext` | `s_i A_l c_i` | `EXT_lights_image_based` light, `irradianceCoefficients` 9 x `[r, g, b]` | KhronosGroup glTF `EXT_lights_image_based` README; basis as Babylon.js's loader reads it |
 //!
 //! with `F_i = k_i A_l / pi` (the "pre-scaled irradiance": coefficient times basis constant `k_i`
 //! times the Lambert factor, over pi, so the tool's polynomial gives `E(n) / pi`, the radiance of a
