@@ -4,8 +4,8 @@
 //! * [`ground_truth`]: the exact irradiance `E(n) = sum_p L_p max(0, n . d_p) dOmega_p` of a
 //!   lat-long probe on a set of normals (normally 20000 Fibonacci normals), plus a fast,
 //!   energy-conserving approximation of it for interactive use;
-//! * [`ibl_core::metrics`] (re-exported): the error of an approximation against that ground truth (`mean_err%`,
-//!   `max_err%`, and the per-normal relative `rel_mean%`, `rel_max%`);
+//! * [`ibl_core::metrics`] (re-exported): the error of an approximation against that ground truth
+//!   (`mean_err%`, `max_err%`, and the per-normal relative `rel_mean%`, `rel_max%`);
 //! * [`mod@sweep`]: the comparison of section 5: every extraction method at every light count N on
 //!   every probe, timed and scored, as the serde data of `report.json` (`iblkit.eval/1`);
 //! * [`report`]: that report as CSV and as a markdown summary (lights needed for 1 % and 5 %);
