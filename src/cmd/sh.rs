@@ -18,10 +18,14 @@ use crate::failure::usage;
 /// Arguments of `ibl sh`.
 #[derive(Args)]
 #[command(after_help = "\
-Formats: json (iblkit, any bands, radiance or irradiance), threejs (LightProbe JSON), filament
-(cmgen's sh.txt), unity (SphericalHarmonicsL2, 27 channel-major floats), webxr and arkit (the 27-float
-layouts), gltf-ext (an EXT_lights_image_based light to merge into a glTF file). Every format but json
-holds 3 bands (9 coefficients).
+Formats (all but json hold 3 bands, 9 coefficients):
+  json       iblkit, any bands, radiance or irradiance
+  threejs    three.js LightProbe JSON
+  filament   cmgen's sh.txt (pre-scaled irradiance)
+  unity      SphericalHarmonicsL2, 27 channel-major floats, Unity's frame
+  webxr      27 floats, RGB per coefficient
+  arkit      27 floats, channel-major
+  gltf-ext   an EXT_lights_image_based light to merge into a glTF file
 
 Examples:
   ibl sh probe.exr                                   SH9 radiance, iblkit JSON on stdout
