@@ -100,6 +100,7 @@ pub fn basis(d: DVec3, bands: usize) -> Vec<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::quadrature::gauss_legendre;
 
     /// The l <= 2 functions of CONVENTIONS section 6, number for number.
     #[test]
@@ -127,29 +128,6 @@ mod tests {
                 assert!((g - w).abs() < 2e-6, "index {k}: {g} vs {w} at {d}");
             }
         }
-    }
-
-    /// Gauss-Legendre nodes and weights on [-1, 1] (Newton on the Legendre recurrence).
-    fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
-        (0..n)
-            .map(|i| {
-                let mut x = (std::f64::consts::PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
-                loop {
-                    let (mut p0, mut p1) = (1.0, x);
-                    for k in 2..=n {
-                        let p2 = ((2 * k - 1) as f64 * x * p1 - (k - 1) as f64 * p0) / k as f64;
-                        p0 = p1;
-                        p1 = p2;
-                    }
-                    let dp = n as f64 * (x * p1 - p0) / (x * x - 1.0);
-                    let dx = p1 / dp;
-                    x -= dx;
-                    if dx.abs() < 1e-15 {
-                        return (x, 2.0 / ((1.0 - x * x) * dp * dp));
-                    }
-                }
-            })
-            .collect()
     }
 
     /// Orthonormality to 31 bands (l <= 30), with a product rule exact for these functions: 64

@@ -7,6 +7,7 @@ pub mod basis;
 pub mod coefficients;
 pub mod convolution;
 pub mod projection;
+mod quadrature;
 pub mod rotation;
 
 pub use basis::{MAX_BANDS, basis, coefficient_count, eval_basis, sh_index};

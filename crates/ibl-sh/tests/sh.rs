@@ -51,7 +51,7 @@ fn white_furnace() {
         let v = e.irradiance(n);
         for ch in 0..3 {
             let want = PI * (ch + 1) as f64;
-            assert!((v[ch] - want).abs() < 1e-4 * want, "{v:?} at {n}");
+            assert!((v[ch] - want).abs() < 1e-12 * want, "{v:?} at {n}");
         }
     }
 }
