@@ -9,7 +9,7 @@
 #![allow(clippy::needless_range_loop)] // channels are indexed 0..3 alongside other arrays
 
 use std::f64::consts::PI;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::OnceLock;
 use std::time::Instant;
 
@@ -148,23 +148,9 @@ fn metrics_on_hand_made_arrays() {
 
 fn probes() -> Vec<(String, Image<Rgb>)> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/probes");
-    let mut paths: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .expect("assets/probes exists")
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "exr"))
-        .collect();
-    paths.sort();
-    assert!(!paths.is_empty(), "no probes in {}", dir.display());
-    paths
-        .into_iter()
-        .map(|p| {
-            let name = p
-                .file_stem()
-                .map(|s| s.to_string_lossy().into_owned())
-                .unwrap_or_default();
-            (name, ibl_io::read_image(&p).expect("probe loads").image)
-        })
-        .collect()
+    let probes = ibl_io::read_images_in(&dir, "exr").expect("the bundled probes load");
+    assert!(!probes.is_empty(), "no probes in {}", dir.display());
+    probes
 }
 
 /// Exact ground truth of every bundled probe on 20000 normals, computed once for the tests that

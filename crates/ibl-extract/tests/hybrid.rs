@@ -4,7 +4,7 @@
 
 #![allow(clippy::unwrap_used)] // tests may panic
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use ibl_core::metrics::mean_err_pct;
 use ibl_core::{Image, LatLong, Rgb, fibonacci_normals, irradiance_exact};
@@ -13,19 +13,9 @@ use ibl_sh::{Window, project_latlong};
 
 fn probes() -> Vec<(String, Image<Rgb>)> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/probes");
-    let mut paths: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap()
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "exr"))
-        .collect();
-    paths.sort();
-    paths
-        .into_iter()
-        .map(|p| {
-            let name = p.file_stem().unwrap().to_string_lossy().into_owned();
-            (name, ibl_io::read_image(&p).unwrap().image)
-        })
-        .collect()
+    let probes = ibl_io::read_images_in(&dir, "exr").expect("the bundled probes load");
+    assert!(!probes.is_empty(), "no probes in {}", dir.display());
+    probes
 }
 
 fn probe_power(probe: &Image<Rgb>) -> [f64; 3] {

@@ -7,7 +7,7 @@
 #![allow(clippy::unwrap_used)] // tests may panic
 #![allow(clippy::needless_range_loop)] // channels are indexed 0..3 alongside other arrays
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
 
 use ibl_core::glam::DVec3;
@@ -17,20 +17,9 @@ use ibl_extract::{OptimizationOptions, irradiance_optimization};
 
 fn probes() -> Vec<(String, Image<Rgb>)> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/probes");
-    let mut paths: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap()
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "exr"))
-        .collect();
-    paths.sort();
-    assert!(!paths.is_empty());
-    paths
-        .into_iter()
-        .map(|p| {
-            let name = p.file_stem().unwrap().to_string_lossy().into_owned();
-            (name, ibl_io::read_image(&p).unwrap().image)
-        })
-        .collect()
+    let probes = ibl_io::read_images_in(&dir, "exr").expect("the bundled probes load");
+    assert!(!probes.is_empty(), "no probes in {}", dir.display());
+    probes
 }
 
 /// (mean_err%, max_err%) of CONVENTIONS section 5.

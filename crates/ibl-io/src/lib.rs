@@ -83,6 +83,31 @@ fn decode(format: ImageFormat, bytes: &[u8], limits: &Limits) -> Result<RawImage
     }
 }
 
+/// Reads every image in `dir` whose extension is `extension` (case-insensitive), in file-name
+/// order, with the default [`Limits`]: `(file stem, image)` pairs. An error names the first file
+/// that cannot be read.
+pub fn read_images_in(dir: &Path, extension: &str) -> Result<Vec<(String, Image<Rgb>)>, IoError> {
+    let entries = std::fs::read_dir(dir).map_err(|e| IoError::read(dir, e))?;
+    let mut paths: Vec<PathBuf> = entries
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            p.extension()
+                .is_some_and(|x| x.eq_ignore_ascii_case(extension))
+        })
+        .collect();
+    paths.sort();
+    paths
+        .into_iter()
+        .map(|p| {
+            let name = p
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            read_image(&p).map(|loaded| (name, loaded.image))
+        })
+        .collect()
+}
+
 /// Reads an image file with the default [`Limits`].
 pub fn read_image(path: &Path) -> Result<LoadedImage, IoError> {
     read_image_with_limits(path, &Limits::default())

@@ -17,7 +17,7 @@
 
 #![allow(clippy::unwrap_used)] // tests may panic
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use ibl_core::glam::Mat3;
 use ibl_core::{Image, Rgb};
@@ -25,24 +25,9 @@ use ibl_mapping::{CubeLayout, Mapping, power, resample};
 
 fn probes() -> Vec<(String, Image<Rgb>)> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/probes");
-    let mut paths: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .expect("assets/probes exists")
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "exr"))
-        .collect();
-    paths.sort();
-    assert!(!paths.is_empty(), "no probes in {}", dir.display());
-    paths
-        .into_iter()
-        .map(|p| {
-            let name = p
-                .file_stem()
-                .map(|s| s.to_string_lossy().into_owned())
-                .unwrap_or_default();
-            let loaded = ibl_io::read_image(&p).expect("probe loads");
-            (name, loaded.image)
-        })
-        .collect()
+    let probes = ibl_io::read_images_in(&dir, "exr").expect("the bundled probes load");
+    assert!(!probes.is_empty(), "no probes in {}", dir.display());
+    probes
 }
 
 fn intermediates() -> Vec<Mapping> {

@@ -5,7 +5,7 @@
 #![allow(clippy::unwrap_used)] // tests may panic
 
 use std::f64::consts::PI;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use ibl_core::glam::{DMat3, DVec3};
 use ibl_core::{Image, IrradianceError, LatLong, Rgb, fibonacci_normals, irradiance_exact};
@@ -160,19 +160,9 @@ fn reconstruction_converges_as_bands_grow() {
 
 fn probes() -> Vec<(String, Image<Rgb>)> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/probes");
-    let mut paths: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap()
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "exr"))
-        .collect();
-    paths.sort();
-    paths
-        .into_iter()
-        .map(|p| {
-            let name = p.file_stem().unwrap().to_string_lossy().into_owned();
-            (name, ibl_io::read_image(&p).unwrap().image)
-        })
-        .collect()
+    let probes = ibl_io::read_images_in(&dir, "exr").expect("the bundled probes load");
+    assert!(!probes.is_empty(), "no probes in {}", dir.display());
+    probes
 }
 
 /// (mean_err%, max_err%) of CONVENTIONS section 5.
