@@ -319,7 +319,8 @@ fn demo_irradiance(
         }
         img
     };
-    let exact = to_image(ibl_core::RowIrradiance::new(image).irradiance(&dirs));
+    let rows = ibl_core::RowIrradiance::new(image);
+    let exact = to_image(rows.irradiance(&dirs));
     let approx = to_image(sh9.eval_many(&dirs));
     let display = Display {
         exposure_stops: ibl_io::tonemap::auto_exposure_stops(&exact),
@@ -343,7 +344,7 @@ fn demo_irradiance(
         previews.push(relative(out, &p));
     }
     let normals = ibl_core::fibonacci_normals(ibl_core::fibonacci::DEFAULT_NORMAL_COUNT);
-    let truth = ibl_core::irradiance_exact(image, &normals);
+    let truth = rows.irradiance(&normals);
     let err = ibl_core::IrradianceError::between(&truth, &sh9.eval_many(&normals));
     let sun = ibl_extract::dominant_light(image)?;
     Ok(IrradianceResult {
