@@ -29,9 +29,25 @@ pub fn is_bad_input(err: &anyhow::Error) -> bool {
     })
 }
 
+/// The error and its causes joined by `: `, leaving out a cause whose text the message already
+/// holds (errors that name a file print their operating-system cause in their own text).
+pub fn message(err: &anyhow::Error) -> String {
+    let mut text = String::new();
+    for cause in err.chain() {
+        let c = cause.to_string();
+        if text.is_empty() {
+            text = c;
+        } else if !text.contains(&c) {
+            text.push_str(": ");
+            text.push_str(&c);
+        }
+    }
+    text
+}
+
 /// Prints `ibl: <error>: <cause>...` to stderr and returns the exit code for it.
 pub fn report(err: &anyhow::Error) -> ExitCode {
-    eprintln!("ibl: {err:#}");
+    eprintln!("ibl: {}", message(err));
     ExitCode::from(if is_bad_input(err) {
         EXIT_BAD_INPUT
     } else {

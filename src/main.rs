@@ -28,6 +28,7 @@ Examples:
   ibl preview probe.exr probe.png --tonemap aces
   ibl lights probe.exr -n 16 -o lights.json
   ibl eval assets/probes/*.exr --out eval     compare every extraction method (report.md)
+  ibl compare render.exr reference.exr       RMSE, relative MSE and FLIP of a render
 
 Exit codes: 0 success, 1 internal failure, 2 bad input or arguments.";
 
@@ -45,6 +46,10 @@ enum Command {
     Sh(cmd::sh::ShArgs),
     /// Compare the light extraction methods on probes: error vs N, plots, spheres, report.
     Eval(cmd::eval::EvalArgs),
+    /// Error metrics of an image against a reference: RMSE, relative MSE, FLIP; error images.
+    Compare(cmd::compare::CompareArgs),
+    /// Render virtual objects into the probe panorama or a photo (reference, lights, hybrid).
+    Render(cmd::render::RenderArgs),
     /// Write a tone-mapped 8-bit preview (PNG or JPEG) of an HDR image.
     Preview(cmd::preview::PreviewArgs),
     /// Run the main job on the bundled probes and write everything to a folder.
@@ -71,6 +76,8 @@ fn main() -> ExitCode {
         Command::Lights(args) => cmd::lights::run(&args),
         Command::Sh(args) => cmd::sh::run(&args),
         Command::Eval(args) => cmd::eval::run(&args),
+        Command::Compare(args) => cmd::compare::run(&args),
+        Command::Render(args) => cmd::render::run(&args),
         Command::Preview(args) => cmd::preview::run(&args),
         Command::Demo(args) => cmd::demo::run(&args),
     };

@@ -5,7 +5,8 @@
 //! trip kept, and writes its irradiance map exact and as SH9 with SH9's error and the probe's
 //! dominant light. Then it runs the comparison of `ibl eval` on the same probes (every extraction
 //! method, SH9 alone and LightGen lights with an SH9 ambient, N = 1 to 128, 20000 scoring normals)
-//! into `eval/`. Everything lands in one folder with
+//! into `eval/`, and renders the example scenes (`renders/`, see [`super::demo_render`]).
+//! Everything lands in one folder with
 //! an `index.html` to look at and a `summary.json` for scripts.
 
 use std::fmt::Write as _;
@@ -20,7 +21,7 @@ use ibl_io::{Display, ToneCurve, WriteOptions};
 use ibl_mapping::{CubeLayout, Mapping};
 use serde::Serialize;
 
-use crate::cmd::{eval, info};
+use crate::cmd::{demo_render, eval, info};
 use crate::envmap_files::{self, MappingArg};
 use crate::failure::usage;
 use crate::progress;
@@ -39,6 +40,9 @@ pub struct DemoArgs {
     /// Folder of lat-long probes to use (default: the bundled `assets/probes`).
     #[arg(long, value_name = "DIR")]
     pub probes: Option<PathBuf>,
+    /// Folder of scene files to render (default: the bundled `assets/scenes`).
+    #[arg(long, value_name = "DIR")]
+    pub scenes: Option<PathBuf>,
 }
 
 /// Light counts of the demo's comparison: the powers of two 1 to 128. `ibl eval` also sweeps 256 by
@@ -123,15 +127,19 @@ struct ProbeResult {
     irradiance: IrradianceResult,
 }
 
-/// Finds the bundled probes: `assets/probes` beside the binary's source tree, else in the
-/// current folder.
-fn default_probe_dir() -> PathBuf {
-    let built_in = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/probes");
+/// The bundled `assets` folder: beside the binary's source tree, else in the current folder.
+pub fn assets_dir() -> PathBuf {
+    let built_in = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets");
     if built_in.is_dir() {
         built_in
     } else {
-        PathBuf::from("assets/probes")
+        PathBuf::from("assets")
     }
+}
+
+/// The bundled probes, `assets/probes`.
+fn default_probe_dir() -> PathBuf {
+    assets_dir().join("probes")
 }
 
 /// Lat-long probes in a folder: `.exr` files (or `.hdr` where no `.exr` of that name exists).
@@ -196,13 +204,23 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
     )?;
     let report = eval::evaluate(&probes, &settings, &args.out.join(EVAL_DIR))
         .context("comparing the light extraction methods")?;
-    write_summary(&args.out, &results, &report)?;
+    let scene_dir = args
+        .scenes
+        .clone()
+        .unwrap_or_else(demo_render::default_scene_dir);
+    let renders = demo_render::demo_renders(&scene_dir, &args.out)?;
+    write_summary(&args.out, &results, &report, &renders)?;
     print_summary(&args.out, &results);
     println!();
     eval::print_lights_needed(&report);
     println!(
         "  {}/{EVAL_DIR}/report.md    the comparison: tables, plots, spheres, overlays",
         args.out.display()
+    );
+    println!(
+        "  {}/{}/report.md the example scenes rendered, lights scored against the reference",
+        args.out.display(),
+        demo_render::RENDER_DIR
     );
     Ok(())
 }
@@ -367,7 +385,8 @@ fn relative_change_pct(before: &[f64; 3], after: &[f64; 3]) -> f64 {
     100.0 * sum / 3.0
 }
 
-fn relative(base: &Path, p: &Path) -> String {
+/// `p` relative to `base` (for links in `index.html`).
+pub fn relative(base: &Path, p: &Path) -> String {
     p.strip_prefix(base).unwrap_or(p).display().to_string()
 }
 
@@ -430,8 +449,17 @@ fn write_summary(
     out: &Path,
     results: &[ProbeResult],
     report: &ibl_eval::Report,
+    renders: &[demo_render::SceneResult],
 ) -> anyhow::Result<()> {
-    let json = serde_json::to_string_pretty(results)?;
+    #[derive(Serialize)]
+    struct Summary<'a> {
+        probes: &'a [ProbeResult],
+        renders: &'a [demo_render::SceneResult],
+    }
+    let json = serde_json::to_string_pretty(&Summary {
+        probes: results,
+        renders,
+    })?;
     std::fs::write(out.join("summary.json"), json)
         .with_context(|| format!("{}: cannot write summary.json", out.display()))?;
     let mut html = String::from(
@@ -497,6 +525,7 @@ fn write_summary(
         }
     }
     html.push_str(&eval_html(report));
+    html.push_str(&demo_render::renders_html(renders));
     std::fs::write(out.join("index.html"), html)
         .with_context(|| format!("{}: cannot write index.html", out.display()))?;
     Ok(())

@@ -1,10 +1,13 @@
 //! One module per subcommand.
 
+pub mod compare;
 pub mod convert;
 pub mod demo;
+pub mod demo_render;
 pub mod eval;
 pub mod info;
 pub mod irradiance;
 pub mod lights;
 pub mod preview;
+pub mod render;
 pub mod sh;

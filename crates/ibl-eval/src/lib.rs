@@ -11,19 +11,27 @@
 //! * [`report`]: that report as CSV and as a markdown summary (lights needed for 1 % and 5 %);
 //! * [`plot`]: error-vs-N charts (the paper's Figure 6) as SVG and RGB images;
 //! * [`sphere_image`]: irradiance spheres and error maps (the paper's Figure 4);
-//! * [`overlay`]: light sets drawn over their probe.
+//! * [`overlay`]: light sets drawn over their probe;
+//! * [`image_difference`]: RMSE, relative MSE, absolute errors and error maps between two images;
+//! * [`mod@flip`]: the FLIP perceptual difference map (Andersson et al. 2020, HDR-FLIP 2021);
+//! * [`render_study`]: light sets judged by their renders against the path-traced reference.
 //!
 //! Nothing here reads or writes files: outputs are strings and 8-bit images in memory.
 //!
-//! Everything is f64 and deterministic: results are bit-identical whatever the rayon thread count.
+//! Sums are f64 (the FLIP map is f32 per pixel) and everything is deterministic: results are
+//! bit-identical whatever the rayon thread count.
 
+pub mod flip;
 pub mod ground_truth;
+pub mod image_difference;
 pub mod overlay;
 pub mod plot;
+pub mod render_study;
 pub mod report;
 pub mod sphere_image;
 pub mod sweep;
 
+pub use flip::{DEFAULT_PIXELS_PER_DEGREE, Flip, FlipOptions, FlipRange, flip};
 pub use ground_truth::{
     Emitters, FAST_DEFAULT_SIZE, GroundTruth, irradiance_brute_force, irradiance_fast,
 };
@@ -31,7 +39,14 @@ pub use ibl_core::metrics::{
     IrradianceError, max_err_pct, mean_err_pct, rel_max_err_pct, rel_mean_err_pct,
 };
 pub use ibl_core::{RowIrradiance, channel_means, irradiance_exact};
+pub use image_difference::{
+    DifferenceError, ImageDifference, MapStatistics, RELATIVE_MSE_EPSILON, absolute_error_map,
+    false_colour, relative_squared_error_map,
+};
 pub use plot::{ErrorChart, PLOT_SIZE, PlotError, render_png, render_svg};
+pub use render_study::{
+    RenderStudy, RenderStudyImages, RenderStudyRow, RenderStudySettings, render_study,
+};
 pub use report::{FigureFiles, LightsNeeded, PlotFiles, ReportFiles};
 pub use sphere_image::{SphereField, SphereFigure};
 pub use sweep::{

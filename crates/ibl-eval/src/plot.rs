@@ -299,6 +299,23 @@ pub struct ErrorChart {
     pub subtitle: String,
     /// One curve per method.
     pub curves: Vec<Curve>,
+    /// Captions of the left panel (the points' `mean_err_pct`) and the right one (`max_err_pct`).
+    pub panel_captions: [String; 2],
+    /// Values marked by dashed lines, and the unit written after them (`" %"`).
+    pub thresholds: (Vec<f64>, String),
+}
+
+impl ErrorChart {
+    /// The panel captions and thresholds of the irradiance-error charts.
+    fn irradiance_axes() -> ([String; 2], (Vec<f64>, String)) {
+        (
+            [
+                "mean error (mean_err), % of mean irradiance".to_string(),
+                "max error (max_err), % of mean irradiance".to_string(),
+            ],
+            (crate::report::THRESHOLDS_PCT.to_vec(), " %".to_string()),
+        )
+    }
 }
 
 /// Which panel a value belongs to.
@@ -317,10 +334,10 @@ impl Panel {
         (v.is_finite() && v > 0.0).then_some(v)
     }
 
-    fn caption(self) -> &'static str {
+    fn caption(self, chart: &ErrorChart) -> &str {
         match self {
-            Panel::Mean => "mean error (mean_err), % of mean irradiance",
-            Panel::Max => "max error (max_err), % of mean irradiance",
+            Panel::Mean => &chart.panel_captions[0],
+            Panel::Max => &chart.panel_captions[1],
         }
     }
 }
@@ -377,10 +394,13 @@ impl ErrorChart {
                 .find(|r| r.method == m && r.n == n && r.status == Status::Ok)
                 .map_or((None, None), |r| (r.mean_err_pct, r.max_err_pct))
         });
+        let (panel_captions, thresholds) = Self::irradiance_axes();
         Some(ErrorChart {
             title: probe.name.clone(),
             subtitle: subtitle(report),
             curves,
+            panel_captions,
+            thresholds,
         })
     }
 
@@ -396,10 +416,13 @@ impl ErrorChart {
                     (Some(a.mean_err_pct), Some(a.max_err_pct))
                 })
         });
+        let (panel_captions, thresholds) = Self::irradiance_axes();
         ErrorChart {
             title: format!("average over {k} probe{}", if k == 1 { "" } else { "s" }),
             subtitle: subtitle(report),
             curves,
+            panel_captions,
+            thresholds,
         }
     }
 }
@@ -501,7 +524,7 @@ fn draw_panel<DB: DrawingBackend>(
     draw_label(
         area,
         mode,
-        panel.caption(),
+        panel.caption(chart),
         (19.0, INK),
         (HPos::Center, VPos::Top),
         (w / 2, 4),
@@ -555,8 +578,11 @@ fn draw_panel<DB: DrawingBackend>(
     }
     let (left, bottom) = at(x0, y0);
     let (right, top) = at(x1, y1);
-    let thresholds: Vec<(f64, i32)> = crate::report::THRESHOLDS_PCT
-        .into_iter()
+    let thresholds: Vec<(f64, i32)> = chart
+        .thresholds
+        .0
+        .iter()
+        .copied()
         .filter(|t| *t > y0 && *t < y1)
         .map(|t| (t, at(x1, t).1))
         .collect();
@@ -576,7 +602,7 @@ fn draw_panel<DB: DrawingBackend>(
             GREY.stroke_width(1),
         ))
         .map_err(PlotError::drawing)?;
-        let label = format!("{t} %");
+        let label = format!("{t}{}", chart.thresholds.1);
         draw_label(
             area,
             mode,
@@ -642,13 +668,25 @@ fn draw_legend<DB: DrawingBackend>(
         )?;
     }
     y += 44;
+    let dashed = chart
+        .thresholds
+        .0
+        .iter()
+        .map(|t| format!("{t}{}", chart.thresholds.1))
+        .collect::<Vec<_>>()
+        .join(" and ");
+    let dashed = if dashed.is_empty() {
+        String::new()
+    } else {
+        format!("dashed: {dashed}")
+    };
     let notes = [
         "dots: measured N",
-        "dashed: 1 % and 5 %",
+        dashed.as_str(),
         "missing dot: skipped",
         "or failed (report.md)",
     ];
-    for note in notes {
+    for note in notes.into_iter().filter(|n| !n.is_empty()) {
         draw_label(
             area,
             mode,

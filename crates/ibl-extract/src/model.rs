@@ -238,8 +238,13 @@ pub fn build_model(
     options: &ExtractOptions,
 ) -> Result<(Model, BTreeMap<String, f64>), ExtractError> {
     if !spec.accepts(n) {
+        let why = match spec.method() {
+            Some(Method::MedianCut) => " (it makes a power of two lights)",
+            _ if matches!(spec, ModelSpec::Lights(LightSource::Sun)) => " (it makes exactly one)",
+            _ => "",
+        };
         return Err(ExtractError::Parameter(format!(
-            "{spec} cannot make {n} lights"
+            "{spec} cannot make {n} lights{why}"
         )));
     }
     let mut parameters = BTreeMap::new();

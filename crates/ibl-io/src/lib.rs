@@ -24,8 +24,10 @@ pub mod hdr;
 pub mod ldr;
 pub mod light_export;
 pub mod light_file;
+pub mod mesh_file;
 pub mod pfm;
 pub mod sanitize;
+pub mod scene_file;
 pub mod sh_file;
 pub mod tonemap;
 
@@ -38,7 +40,9 @@ pub use error::{DecodeError, EncodeError, IoError};
 pub use exr::{ExrCompression, ExrOptions, ExrPrecision};
 pub use format::{ImageFormat, Limits, RawImage};
 pub use light_export::{ExportError, ExportOptions, LightFormat, write_light_file};
+pub use mesh_file::{LoadedMesh, MeshLimits, read_mesh};
 pub use sanitize::{SanitizeReport, sanitize};
+pub use scene_file::{LoadedScene, read_scene};
 pub use sh_file::{ShFile, ShFileFormat, ShQuantity, read_sh_file, write_sh_file};
 pub use tonemap::{Display, ToneCurve};
 

@@ -1,0 +1,146 @@
+//! Scene files (`docs/SCENES.md`): reads the TOML description, then everything it names (the
+//! probe, the photograph, the meshes), relative to the scene file's folder, and assembles an
+//! [`ibl_scene::Scene`].
+//!
+//! Every error names a file: the scene file and the field at fault (`scene.toml: object[0].scale:
+//! 0 is not a non-zero finite number`), or the asset and what is wrong with it, prefixed by the
+//! scene field that named it (`scene.toml: object[1].file: bunny.glb: ...`).
+
+use std::path::{Path, PathBuf};
+
+use ibl_core::{Image, Rgb};
+use ibl_scene::description::{BackgroundKind, GeometryDescription, ShapeKind};
+use ibl_scene::{MeshAsset, Scene, SceneDescription};
+
+use crate::IoError;
+use crate::mesh_file::{MeshLimits, read_mesh};
+
+/// Largest scene file accepted, bytes.
+pub const MAX_SCENE_BYTES: u64 = 4 << 20;
+
+/// A scene read from a file, with the resolved paths of what it loaded.
+#[derive(Clone, Debug)]
+pub struct LoadedScene {
+    /// The description as written.
+    pub description: SceneDescription,
+    /// The assembled scene.
+    pub scene: Scene,
+    /// The probe file, resolved.
+    pub probe_path: PathBuf,
+    /// The light file named by `[lighting] lights_file`, resolved.
+    pub lights_path: Option<PathBuf>,
+    /// Every input file the scene read (for "never write over an input").
+    pub inputs: Vec<PathBuf>,
+}
+
+fn invalid(path: &Path, reason: impl Into<String>) -> IoError {
+    IoError::Invalid {
+        path: path.to_path_buf(),
+        reason: reason.into(),
+    }
+}
+
+/// Parses a scene description from the text of `path` (no asset is read).
+pub fn parse_scene(path: &Path, text: &str) -> Result<SceneDescription, IoError> {
+    SceneDescription::from_toml(text).map_err(|e| invalid(path, e.to_string()))
+}
+
+/// Reads a scene file and everything it names.
+pub fn read_scene(path: &Path) -> Result<LoadedScene, IoError> {
+    let size = std::fs::metadata(path)
+        .map_err(|e| IoError::read(path, e))?
+        .len();
+    if size > MAX_SCENE_BYTES {
+        return Err(IoError::Limits {
+            path: path.to_path_buf(),
+            what: format!("{size} bytes (a scene file is at most {MAX_SCENE_BYTES})"),
+        });
+    }
+    let bytes = std::fs::read(path).map_err(|e| IoError::read(path, e))?;
+    let text = String::from_utf8(bytes).map_err(|_| invalid(path, "not UTF-8 text"))?;
+    let description = parse_scene(path, &text)?;
+    let folder = path.parent().unwrap_or(Path::new("."));
+    let resolve = |p: &Path| folder.join(p);
+    let mut inputs = vec![path.to_path_buf()];
+
+    // An asset's error, prefixed by the scene file and the field that named it.
+    let asset_error = |field: &str, e: IoError| -> IoError {
+        let bad = e.is_bad_input();
+        let message = format!("{field}: {e}");
+        if bad {
+            invalid(path, message)
+        } else {
+            IoError::Io {
+                path: path.to_path_buf(),
+                source: std::io::Error::other(message),
+            }
+        }
+    };
+
+    let probe_path = resolve(&description.probe.file);
+    let probe = crate::read_image(&probe_path)
+        .map_err(|e| asset_error("probe.file", e))?
+        .image;
+    if probe.width() != 2 * probe.height() {
+        return Err(invalid(
+            path,
+            format!(
+                "probe.file: {}: {} x {} is not a 2:1 lat-long map (convert it with `ibl convert --to latlong`)",
+                probe_path.display(),
+                probe.width(),
+                probe.height()
+            ),
+        ));
+    }
+    inputs.push(probe_path.clone());
+
+    let photo: Option<Image<Rgb>> =
+        match (description.background.kind, &description.background.file) {
+            (BackgroundKind::Photo, Some(file)) => {
+                let p = resolve(file);
+                let image = crate::read_image(&p)
+                    .map_err(|e| asset_error("background.file", e))?
+                    .image;
+                inputs.push(p);
+                Some(image)
+            }
+            _ => None,
+        };
+
+    let limits = MeshLimits::default();
+    let mut load =
+        |table: &str, entries: &[GeometryDescription]| -> Result<Vec<Option<MeshAsset>>, IoError> {
+            entries
+                .iter()
+                .enumerate()
+                .map(|(i, entry)| match (entry.shape, &entry.file) {
+                    (ShapeKind::Mesh, Some(file)) => {
+                        let p = resolve(file);
+                        let loaded = read_mesh(&p, &limits)
+                            .map_err(|e| asset_error(&format!("{table}[{i}].file"), e))?;
+                        inputs.push(p);
+                        Ok(Some(MeshAsset {
+                            mesh: loaded.mesh,
+                            base_albedo: loaded.base_colors,
+                        }))
+                    }
+                    _ => Ok(None),
+                })
+                .collect()
+        };
+    let local = load("local", &description.local)?;
+    let objects = load("object", &description.object)?;
+    let lights_path = description.lighting.lights_file.as_deref().map(resolve);
+    if let Some(p) = &lights_path {
+        inputs.push(p.clone());
+    }
+    let scene = Scene::assemble(&description, probe, photo, local, objects)
+        .map_err(|e| invalid(path, e.to_string()))?;
+    Ok(LoadedScene {
+        description,
+        scene,
+        probe_path,
+        lights_path,
+        inputs,
+    })
+}

@@ -1,0 +1,36 @@
+//! The iblkit CPU renderer: virtual objects lit by a light probe and composited into real imagery
+//! by differential rendering (Debevec 1998; Grosch 2005 section 4.1; Madsen & Laursen 2006 use it
+//! to compare light approximations).
+//!
+//! - [`render`]: the driver and the differential composite (with and without the objects).
+//! - [`tracer`]: one light path, in the reference, lights or hybrid mode.
+//! - [`lighting`]: what lights each mode (environment, directional lights, lights + SH ambient).
+//! - [`background`]: the background at the output size.
+//! - [`environment`]: the probe as an importance-sampled environment light.
+//! - [`material`]: BSDFs of the scene's materials (evaluate, sample, density).
+//! - [`sampling`]: per-sample random streams, warps and discrete distributions.
+
+pub mod background;
+pub mod environment;
+pub mod lighting;
+pub mod material;
+pub mod render;
+pub mod sampling;
+pub mod tracer;
+
+pub use lighting::{Illumination, Lighting};
+pub use render::{RenderOutput, RenderSettings, RenderStats, render};
+
+/// Why a render cannot be made.
+#[derive(Debug, thiserror::Error)]
+pub enum RenderError {
+    /// A setting is out of range.
+    #[error("{0}")]
+    Parameter(String),
+    /// The probe cannot be used as an environment light.
+    #[error("the probe cannot light the scene: {0}")]
+    Environment(#[from] environment::EnvironmentError),
+    /// The lights cannot be made.
+    #[error("extracting the lights: {0}")]
+    Extract(#[from] ibl_extract::ExtractError),
+}

@@ -1,0 +1,275 @@
+//! The render driver and differential rendering (Debevec 1998, section 5; Grosch 2005 section
+//! 4.1): every pixel sample is traced through the scene with the virtual objects and, where that
+//! path touched them, again without them, with the same random numbers.
+//!
+//! For a pixel of background `B` with `n` samples, of which the `k` whose primary ray met a
+//! virtual object gave radiance `O_s`, and the others gave `W_s` with and `V_s` without the
+//! objects, the composite is
+//!
+//! ```text
+//! C = B (n - k) / n + (sum_s O_s + sum_s (W_s - V_s)) / n
+//! ```
+//!
+//! (the `difference` rule; the `ratio` rule replaces the second sum by `B (n - k) / n * (sum_s
+//! W_s / sum_s V_s - 1)`, see [`CompositeRule`]): the object's own pixels from the render,
+//! everything else the background plus the change the objects make (shadows, reflected light), antialiased by the sample split along the edges. A
+//! path that never touched the virtual layer has `W_s = V_s` exactly (see [`crate::tracer`]), so an
+//! empty scene, or any pixel the objects do not affect, composites to `B` bit for bit (`B * 1.0 +
+//! 0.0`). Negative results (a modelled shadow darker than the photographed surface) clamp to 0.
+//!
+//! Every pixel sample draws from its own random stream `(seed, pixel, sample)`, rows run in
+//! parallel with rayon, and each pixel sums its samples in order: the image depends on the seed
+//! only, never on the thread count. Cost: O(W H n) paths (see [`crate::tracer`] per path).
+
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use ibl_core::{Image, Rgb};
+use ibl_scene::Scene;
+use ibl_scene::description::CompositeRule;
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::RenderError;
+use crate::background::background_image;
+use crate::lighting::Lighting;
+use crate::sampling::PixelRng;
+use crate::tracer::{Layers, PrimaryHit, Tracer};
+
+/// How to render.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RenderSettings {
+    /// How the objects' effect on real surfaces joins the background.
+    pub composite: CompositeRule,
+    /// Output width in pixels (`None`: the background's own width).
+    pub width: Option<u32>,
+    /// Samples per pixel, at least 1.
+    pub spp: u32,
+    /// Surface vertices per path, at least 1 (1 = direct light only).
+    pub bounces: u32,
+    /// Seed of every random number.
+    pub seed: u64,
+}
+
+/// What a render counted.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct RenderStats {
+    /// Output width, pixels.
+    pub width: u32,
+    /// Output height, pixels.
+    pub height: u32,
+    /// Samples per pixel.
+    pub spp: u32,
+    /// Paths traced with the objects.
+    pub paths: u64,
+    /// Paths traced again without the objects (they touched a virtual object).
+    pub paths_without_objects: u64,
+    /// Rays traced (closest-hit and shadow queries, both passes).
+    pub rays: u64,
+    /// Fraction of pixel samples whose primary ray met a virtual object.
+    pub object_coverage: f64,
+}
+
+/// The images of a render, all `width x height`, linear radiance.
+#[derive(Clone, Debug)]
+pub struct RenderOutput {
+    /// Background plus the objects' effect, the objects themselves on top: the final image.
+    pub composite: Image<Rgb>,
+    /// The local scene with the virtual objects (background where the camera sees no geometry).
+    pub with_objects: Image<Rgb>,
+    /// The local scene without the virtual objects.
+    pub without_objects: Image<Rgb>,
+    /// The background at the output size.
+    pub background: Image<Rgb>,
+    /// Per pixel, the fraction of samples whose primary ray met a virtual object (alpha).
+    pub object_coverage: Image<f32>,
+    /// Counters.
+    pub stats: RenderStats,
+}
+
+/// One pixel's sums.
+#[derive(Clone, Copy, Default)]
+struct PixelSums {
+    object: Rgb,
+    /// Sums over the samples whose primary ray met real geometry, with and without the objects
+    /// (the ratio rule).
+    real_with: Rgb,
+    real_without: Rgb,
+    difference: Rgb,
+    with: Rgb,
+    without: Rgb,
+    object_samples: u32,
+    background_samples: u32,
+    paths_without: u64,
+    rays: u64,
+}
+
+/// Renders `scene` under `lighting` and composites it into the background. `progress(rows_done,
+/// rows_total)` is called after each row, from worker threads.
+pub fn render(
+    scene: &Scene,
+    lighting: &Lighting,
+    settings: &RenderSettings,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<RenderOutput, RenderError> {
+    if settings.spp == 0 {
+        return Err(RenderError::Parameter(
+            "samples per pixel must be at least 1".into(),
+        ));
+    }
+    let default_width = match &scene.background {
+        ibl_scene::Background::Panorama => scene.probe.radiance.width() as u32,
+        ibl_scene::Background::Photo(photo) => photo.width() as u32,
+    };
+    let (width, height) = scene.camera.output_size(settings.width, default_width);
+    if width as usize * height as usize > MAX_PIXELS {
+        return Err(RenderError::Parameter(format!(
+            "{width} x {height} is more than {MAX_PIXELS} pixels"
+        )));
+    }
+    let background = background_image(scene, width, height)?;
+    let tracer = Tracer::new(scene, lighting, settings.bounces);
+    let (w, h) = (width as usize, height as usize);
+    let rows_done = AtomicUsize::new(0);
+    let rows: Vec<Vec<PixelSums>> = (0..h)
+        .into_par_iter()
+        .map(|y| {
+            let row = (0..w)
+                .map(|x| pixel(&tracer, scene, settings, x, y, width, height))
+                .collect();
+            progress(rows_done.fetch_add(1, Ordering::Relaxed) + 1, h);
+            row
+        })
+        .collect();
+    let n = settings.spp as f32;
+    let mut stats = RenderStats {
+        width,
+        height,
+        spp: settings.spp,
+        paths: w as u64 * h as u64 * u64::from(settings.spp),
+        ..RenderStats::default()
+    };
+    let mut composite = Vec::with_capacity(w * h);
+    let mut with_objects = Vec::with_capacity(w * h);
+    let mut without_objects = Vec::with_capacity(w * h);
+    let mut coverage = Vec::with_capacity(w * h);
+    let mut object_samples = 0u64;
+    for (sums, &b) in rows.iter().flatten().zip(background.pixels()) {
+        let other = settings.spp - sums.object_samples;
+        let c = match settings.composite {
+            CompositeRule::Difference => {
+                b * (other as f32 / n) + (sums.object + sums.difference) / n
+            }
+            CompositeRule::Ratio => {
+                let ratio = |w: f32, v: f32, d: f32, b: f32| {
+                    if d == 0.0 {
+                        b
+                    } else if v > 0.0 {
+                        b * (w / v)
+                    } else {
+                        b + d / other.max(1) as f32
+                    }
+                };
+                let real = Rgb::new(
+                    ratio(
+                        sums.real_with.r,
+                        sums.real_without.r,
+                        sums.difference.r,
+                        b.r,
+                    ),
+                    ratio(
+                        sums.real_with.g,
+                        sums.real_without.g,
+                        sums.difference.g,
+                        b.g,
+                    ),
+                    ratio(
+                        sums.real_with.b,
+                        sums.real_without.b,
+                        sums.difference.b,
+                        b.b,
+                    ),
+                );
+                real * (other as f32 / n) + sums.object / n
+            }
+        };
+        composite.push(c.map(|v| v.max(0.0)));
+        let bg = b * sums.background_samples as f32;
+        with_objects.push((sums.with + bg) / n);
+        without_objects.push((sums.without + bg) / n);
+        coverage.push(sums.object_samples as f32 / n);
+        object_samples += u64::from(sums.object_samples);
+        stats.paths_without_objects += sums.paths_without;
+        stats.rays += sums.rays;
+    }
+    stats.object_coverage = object_samples as f64 / stats.paths.max(1) as f64;
+    let image =
+        |data| Image::from_vec(w, h, data).map_err(|e| RenderError::Parameter(e.to_string()));
+    Ok(RenderOutput {
+        composite: image(composite)?,
+        with_objects: image(with_objects)?,
+        without_objects: image(without_objects)?,
+        background,
+        object_coverage: Image::from_vec(w, h, coverage)
+            .map_err(|e| RenderError::Parameter(e.to_string()))?,
+        stats,
+    })
+}
+
+/// Largest output, pixels (a 16384 x 8192 panorama).
+pub const MAX_PIXELS: usize = 16384 * 8192;
+
+fn pixel(
+    tracer: &Tracer,
+    scene: &Scene,
+    settings: &RenderSettings,
+    x: usize,
+    y: usize,
+    width: u32,
+    height: u32,
+) -> PixelSums {
+    let index = (y as u64) * u64::from(width) + x as u64;
+    let mut sums = PixelSums::default();
+    for s in 0..settings.spp {
+        let mut rng = PixelRng::new(settings.seed, index, s);
+        let (jx, jy) = (rng.next_f32(), rng.next_f32());
+        let ray = scene
+            .camera
+            .ray(x as f32 + jx, y as f32 + jy, width, height);
+        let with = tracer.trace(ray, Layers::WithObjects, &mut rng);
+        sums.rays += with.rays;
+        match with.primary {
+            PrimaryHit::Virtual => {
+                sums.object += with.radiance;
+                sums.with += with.radiance;
+                sums.object_samples += 1;
+                // The same camera ray without the objects, for the "without" layer.
+                let mut rng = PixelRng::new(settings.seed, index, s);
+                let _ = (rng.next_f32(), rng.next_f32());
+                let without = tracer.trace(ray, Layers::RealOnly, &mut rng);
+                sums.without += without.radiance;
+                sums.rays += without.rays;
+                sums.paths_without += 1;
+            }
+            PrimaryHit::Background => sums.background_samples += 1,
+            PrimaryHit::Real => {
+                sums.with += with.radiance;
+                if with.touched_virtual {
+                    let mut rng = PixelRng::new(settings.seed, index, s);
+                    let _ = (rng.next_f32(), rng.next_f32());
+                    let without = tracer.trace(ray, Layers::RealOnly, &mut rng);
+                    sums.without += without.radiance;
+                    sums.difference += with.radiance - without.radiance;
+                    sums.real_with += with.radiance;
+                    sums.real_without += without.radiance;
+                    sums.rays += without.rays;
+                    sums.paths_without += 1;
+                } else {
+                    sums.without += with.radiance;
+                    sums.real_with += with.radiance;
+                    sums.real_without += with.radiance;
+                }
+            }
+        }
+    }
+    sums
+}

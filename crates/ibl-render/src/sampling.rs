@@ -1,0 +1,384 @@
+//! Monte Carlo sampling building blocks: a per-pixel random number generator, an orthonormal basis
+//! from a normal, cosine-weighted hemisphere and uniform cone sampling with their densities, a
+//! piecewise-constant 1-D distribution and the power heuristic for multiple importance sampling.
+//!
+//! - [`PixelRng`]: PCG32 (O'Neill 2014, the `XSH RR` output on a 64-bit LCG) whose state and stream
+//!   are a `splitmix64` hash (Steele et al. 2014) of `(seed, pixel, sample)`. Every pixel sample
+//!   owns its own generator, so an image does not depend on the thread count or on the order in
+//!   which pixels are rendered. `next_f32` returns the top 24 bits, a multiple of `2^-24` in
+//!   `[0, 1)`. O(1) per number.
+//! - [`OrthonormalBasis`]: the branchless construction of Duff et al. 2017 ("Building an orthonormal
+//!   basis, revisited", JCGT 6(1)); `to_world` and `to_local` convert between the world frame and
+//!   the local frame whose `+z` is the normal.
+//! - [`sample_cosine_hemisphere`]: Malley's method on the concentric disc map of Shirley and Chiu
+//!   1997, `pdf = cos(theta) / pi` per steradian (local `+z` up).
+//! - [`UniformCone`]: directions uniform in solid angle within `theta <= a` about local `+z`. A light
+//!   of solid angle `A` (sr) is the cone with `A = 2 pi (1 - cos a)`; the cone keeps `1 - cos a`
+//!   itself so that cones of a sun's size (`A ~ 6e-5 sr`) lose no precision; `pdf = 1 / A`.
+//!   With `A = 4 pi` it is the uniform sphere.
+//! - [`Distribution1D`]: discrete sampling proportional to non-negative weights by binary search on
+//!   an f32 CDF, O(n) to build (sums in f64), O(log n) to sample. The probability it reports for a
+//!   cell is the width of that cell in the stored CDF, which is exactly the probability that a
+//!   uniform `u` selects it, so densities and samples never disagree.
+//! - [`power_heuristic`]: Veach 1997 (section 9.2.4), exponent 2, one sample per technique.
+//!
+//! Directions are unit `Vec3` in whatever frame the caller works in (the world frame of
+//! `docs/CONVENTIONS.md` section 1 for the renderer); densities are per steradian.
+
+use std::f32::consts::{FRAC_1_PI, FRAC_PI_4, PI, TAU};
+
+use glam::Vec3;
+
+/// `splitmix64` finaliser (Steele, Lea and Flood 2014): a bijective 64-bit mixer.
+fn splitmix64(x: u64) -> u64 {
+    let mut z = x.wrapping_add(0x9e37_79b9_7f4a_7c15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
+}
+
+/// PCG32 LCG multiplier (O'Neill 2014).
+const PCG_MULTIPLIER: u64 = 6_364_136_223_846_793_005;
+
+/// A small, fast random number generator owned by one sample of one pixel (PCG32).
+#[derive(Clone, Debug)]
+pub struct PixelRng {
+    state: u64,
+    increment: u64,
+}
+
+impl PixelRng {
+    /// The generator of sample `sample` of pixel `pixel` (any linear pixel index) for a render
+    /// seeded with `seed`. Equal arguments give equal sequences on every machine and thread count.
+    pub fn new(seed: u64, pixel: u64, sample: u32) -> Self {
+        let key = splitmix64(seed ^ splitmix64(pixel.wrapping_add(splitmix64(u64::from(sample)))));
+        let mut rng = PixelRng {
+            state: 0,
+            increment: (splitmix64(key ^ 0x5851_f42d_4c95_7f2d) << 1) | 1,
+        };
+        rng.next_u32();
+        rng.state = rng.state.wrapping_add(key);
+        rng.next_u32();
+        rng
+    }
+
+    /// The next 32 uniformly distributed bits.
+    pub fn next_u32(&mut self) -> u32 {
+        let old = self.state;
+        self.state = old
+            .wrapping_mul(PCG_MULTIPLIER)
+            .wrapping_add(self.increment);
+        let xorshifted = (((old >> 18) ^ old) >> 27) as u32;
+        xorshifted.rotate_right((old >> 59) as u32)
+    }
+
+    /// A uniform number in `[0, 1)`: a multiple of `2^-24`, so `1.0` is never returned.
+    pub fn next_f32(&mut self) -> f32 {
+        (self.next_u32() >> 8) as f32 * (1.0 / 16_777_216.0)
+    }
+}
+
+/// A right-handed orthonormal basis `(tangent, bitangent, normal)`: local `(x, y, z)` axes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OrthonormalBasis {
+    /// Local `+x`, unit, perpendicular to `normal`.
+    pub tangent: Vec3,
+    /// Local `+y`, `normal x tangent`.
+    pub bitangent: Vec3,
+    /// Local `+z`, the unit normal the basis was built from.
+    pub normal: Vec3,
+}
+
+impl OrthonormalBasis {
+    /// The basis about a unit normal (Duff et al. 2017, Listing 3, branchless: no singularity at
+    /// `n.z = -1`). `n` must be unit length; the result is orthonormal to f32 rounding.
+    pub fn from_normal(n: Vec3) -> Self {
+        let sign = 1.0_f32.copysign(n.z);
+        let a = -1.0 / (sign + n.z);
+        let b = n.x * n.y * a;
+        OrthonormalBasis {
+            tangent: Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x),
+            bitangent: Vec3::new(b, sign + n.y * n.y * a, -n.y),
+            normal: n,
+        }
+    }
+
+    /// World vector of local coordinates `v` (`v.z` along the normal).
+    pub fn to_world(&self, v: Vec3) -> Vec3 {
+        self.tangent * v.x + self.bitangent * v.y + self.normal * v.z
+    }
+
+    /// Local coordinates of world vector `v`.
+    pub fn to_local(&self, v: Vec3) -> Vec3 {
+        Vec3::new(
+            v.dot(self.tangent),
+            v.dot(self.bitangent),
+            v.dot(self.normal),
+        )
+    }
+}
+
+/// Maps `[0, 1)^2` onto the unit disc preserving relative area (Shirley and Chiu 1997).
+fn concentric_disc(u1: f32, u2: f32) -> (f32, f32) {
+    let a = 2.0 * u1 - 1.0;
+    let b = 2.0 * u2 - 1.0;
+    if a == 0.0 && b == 0.0 {
+        return (0.0, 0.0);
+    }
+    let (r, phi) = if a.abs() > b.abs() {
+        (a, FRAC_PI_4 * (b / a))
+    } else {
+        (b, 2.0 * FRAC_PI_4 - FRAC_PI_4 * (a / b))
+    };
+    let (s, c) = phi.sin_cos();
+    (r * c, r * s)
+}
+
+/// A cosine-distributed direction about local `+z` from `u1, u2` in `[0, 1)` (Malley's method):
+/// density `cos(theta) / pi` per steradian, see [`cosine_hemisphere_pdf`]. The result has
+/// `z >= 0` and unit length.
+pub fn sample_cosine_hemisphere(u1: f32, u2: f32) -> Vec3 {
+    let (x, y) = concentric_disc(u1, u2);
+    let z = (1.0 - x * x - y * y).max(0.0).sqrt();
+    Vec3::new(x, y, z)
+}
+
+/// Density (1/sr) of [`sample_cosine_hemisphere`] for a direction with `cos(theta) = cos_theta`
+/// to the axis: `max(0, cos_theta) / pi`.
+pub fn cosine_hemisphere_pdf(cos_theta: f32) -> f32 {
+    cos_theta.max(0.0) * FRAC_1_PI
+}
+
+/// Directions uniform in solid angle within a cone of half-angle `a` about local `+z`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct UniformCone {
+    /// `1 - cos(a)`, in `(0, 2]`.
+    one_minus_cos: f32,
+}
+
+impl UniformCone {
+    /// The whole sphere (`a = pi`, solid angle `4 pi`).
+    pub const SPHERE: UniformCone = UniformCone { one_minus_cos: 2.0 };
+
+    /// The cone of solid angle `solid_angle_sr` (sr), `cos(a) = 1 - A / (2 pi)`; solid angles
+    /// above `4 pi` give the sphere. `None` when the solid angle is not finite and positive.
+    pub fn from_solid_angle(solid_angle_sr: f32) -> Option<Self> {
+        (solid_angle_sr.is_finite() && solid_angle_sr > 0.0).then(|| UniformCone {
+            one_minus_cos: (solid_angle_sr / TAU).min(2.0),
+        })
+    }
+
+    /// The cone of half-angle `half_angle` (radians, `(0, pi]`; larger angles give the sphere).
+    /// `None` when the angle is not finite and positive.
+    pub fn from_half_angle(half_angle: f32) -> Option<Self> {
+        (half_angle.is_finite() && half_angle > 0.0).then(|| {
+            let s = (0.5 * half_angle.min(PI)).sin();
+            UniformCone {
+                one_minus_cos: 2.0 * s * s,
+            }
+        })
+    }
+
+    /// Solid angle (sr): `2 pi (1 - cos a)`.
+    pub fn solid_angle(&self) -> f32 {
+        TAU * self.one_minus_cos
+    }
+
+    /// Cosine of the half-angle.
+    pub fn cos_half_angle(&self) -> f32 {
+        1.0 - self.one_minus_cos
+    }
+
+    /// Density (1/sr) of a direction inside the cone: `1 / solid_angle`.
+    pub fn pdf(&self) -> f32 {
+        1.0 / self.solid_angle()
+    }
+
+    /// A direction about local `+z` from `u1, u2` in `[0, 1)`: `1 - cos(theta) = u1 (1 - cos a)`,
+    /// `phi = 2 pi u2`; unit length, and `sin(theta)` comes from `1 - cos(theta)` so tiny cones
+    /// stay accurate.
+    pub fn sample(&self, u1: f32, u2: f32) -> Vec3 {
+        let one_minus_cos = u1 * self.one_minus_cos;
+        let cos_theta = 1.0 - one_minus_cos;
+        let sin_theta = (one_minus_cos * (2.0 - one_minus_cos)).max(0.0).sqrt();
+        let (sp, cp) = (TAU * u2).sin_cos();
+        Vec3::new(sin_theta * cp, sin_theta * sp, cos_theta)
+    }
+}
+
+/// A discrete distribution over `n` cells proportional to non-negative weights, sampled by
+/// inverting its cumulative distribution (binary search).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Distribution1D {
+    /// `n + 1` non-decreasing values, `cdf[0] = 0`, `cdf[n] = 1`.
+    cdf: Vec<f32>,
+    /// Sum of the weights (f64).
+    total: f64,
+}
+
+/// One draw from a [`Distribution1D`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DiscreteSample {
+    /// The chosen cell.
+    pub index: usize,
+    /// Its probability (the width of its CDF step), in `(0, 1]`.
+    pub probability: f32,
+    /// Where `u` fell inside the cell's step, rescaled to `[0, 1)`: a fresh uniform number.
+    pub remapped: f32,
+}
+
+impl Distribution1D {
+    /// The distribution proportional to `weights`. Weights that are negative or not finite count
+    /// as 0. When every weight is 0 (or there are none) the cells are equally likely and
+    /// [`Distribution1D::total`] reports 0. O(n).
+    pub fn new(weights: impl IntoIterator<Item = f64>) -> Self {
+        let mut prefix = vec![0.0_f64];
+        let mut sum = 0.0_f64;
+        for w in weights {
+            if w.is_finite() && w > 0.0 {
+                sum += w;
+            }
+            prefix.push(sum);
+        }
+        let n = prefix.len() - 1;
+        let cdf: Vec<f32> = if sum > 0.0 {
+            prefix.iter().map(|&p| (p / sum) as f32).collect()
+        } else {
+            (0..=n)
+                .map(|k| (k as f64 / n.max(1) as f64) as f32)
+                .collect()
+        };
+        let mut dist = Distribution1D { cdf, total: sum };
+        if let Some(last) = dist.cdf.last_mut() {
+            *last = 1.0;
+        }
+        dist
+    }
+
+    /// Number of cells.
+    pub fn len(&self) -> usize {
+        self.cdf.len() - 1
+    }
+
+    /// Whether there are no cells.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Sum of the (valid, positive) weights, f64.
+    pub fn total(&self) -> f64 {
+        self.total
+    }
+
+    /// Probability of cell `index` (0 outside the range).
+    pub fn probability(&self, index: usize) -> f32 {
+        match (self.cdf.get(index), self.cdf.get(index + 1)) {
+            (Some(&lo), Some(&hi)) => hi - lo,
+            _ => 0.0,
+        }
+    }
+
+    /// The cell selected by `u` in `[0, 1)` (values outside are clamped): the last cell whose
+    /// CDF start is `<= u`, which always has a positive probability. `None` only when the
+    /// distribution has no cells. O(log n).
+    pub fn sample(&self, u: f32) -> Option<DiscreteSample> {
+        let n = self.len();
+        if n == 0 {
+            return None;
+        }
+        let u = if u.is_nan() {
+            0.0
+        } else {
+            u.clamp(0.0, 1.0 - f32::EPSILON / 2.0)
+        };
+        let index = (self.cdf.partition_point(|&c| c <= u) - 1).min(n - 1);
+        let lo = self.cdf[index];
+        let probability = self.cdf[index + 1] - lo;
+        let remapped = ((u - lo) / probability).clamp(0.0, 1.0 - f32::EPSILON / 2.0);
+        Some(DiscreteSample {
+            index,
+            probability,
+            remapped,
+        })
+    }
+}
+
+/// Veach's power heuristic (exponent 2) for one sample from each of two techniques: the weight of
+/// a sample drawn from the technique with density `pdf_this` when the other would have drawn it
+/// with density `pdf_other`, `pdf_this^2 / (pdf_this^2 + pdf_other^2)`. 0 when `pdf_this` is 0;
+/// 1 when `pdf_this` is infinite (a delta) and `pdf_other` finite. Computed as a ratio, so huge
+/// densities do not overflow.
+pub fn power_heuristic(pdf_this: f32, pdf_other: f32) -> f32 {
+    if pdf_this.is_nan() || pdf_this <= 0.0 {
+        return 0.0;
+    }
+    if pdf_this.is_infinite() {
+        return if pdf_other.is_infinite() { 0.5 } else { 1.0 };
+    }
+    let ratio = pdf_other.max(0.0) / pdf_this;
+    1.0 / (1.0 + ratio * ratio)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn distribution_skips_zero_cells_and_reports_step_widths() {
+        let dist = Distribution1D::new([0.0, 1.0, 0.0, 0.0, 3.0, 0.0]);
+        assert_eq!(dist.len(), 6);
+        assert_eq!(dist.total(), 4.0);
+        assert_eq!(dist.probability(1), 0.25);
+        assert_eq!(dist.probability(4), 0.75);
+        assert_eq!(dist.probability(0), 0.0);
+        assert_eq!(dist.probability(9), 0.0);
+        for k in 0..1000 {
+            let u = k as f32 / 1000.0;
+            let s = dist.sample(u).unwrap();
+            assert!(s.index == 1 || s.index == 4, "u {u} chose {}", s.index);
+            assert_eq!(s.probability, dist.probability(s.index));
+            assert!((0.0..1.0).contains(&s.remapped));
+        }
+        assert_eq!(dist.sample(0.0).unwrap().index, 1);
+        assert_eq!(dist.sample(0.25).unwrap().index, 4);
+        assert_eq!(dist.sample(0.999_999_9).unwrap().index, 4);
+    }
+
+    #[test]
+    fn all_zero_distribution_is_uniform() {
+        let dist = Distribution1D::new([0.0; 4]);
+        assert_eq!(dist.total(), 0.0);
+        for k in 0..4 {
+            assert_eq!(dist.probability(k), 0.25);
+        }
+        assert_eq!(dist.sample(0.6).unwrap().index, 2);
+        assert!(
+            Distribution1D::new(std::iter::empty())
+                .sample(0.5)
+                .is_none()
+        );
+    }
+
+    #[test]
+    fn remapped_u_is_uniform_within_cell() {
+        let dist = Distribution1D::new([1.0, 3.0]);
+        let s = dist.sample(0.25 + 0.75 * 0.5).unwrap();
+        assert_eq!(s.index, 1);
+        assert!((s.remapped - 0.5).abs() < 1e-6);
+    }
+
+    #[test]
+    fn cone_from_half_angle_matches_solid_angle() {
+        let a = 0.3_f32;
+        let cone = UniformCone::from_half_angle(a).unwrap();
+        let expected = TAU * (1.0 - a.cos());
+        assert!((cone.solid_angle() - expected).abs() < 1e-6 * expected);
+        assert!(UniformCone::from_half_angle(-1.0).is_none());
+        assert!(UniformCone::from_solid_angle(0.0).is_none());
+        assert!(UniformCone::from_solid_angle(f32::NAN).is_none());
+        assert_eq!(
+            UniformCone::from_solid_angle(100.0),
+            Some(UniformCone::SPHERE)
+        );
+    }
+}

@@ -1,0 +1,483 @@
+//! The scene file format (`docs/SCENES.md`): the bundled examples parse and validate, every
+//! validation rule names its field by path (`object[1].scale`, `camera.up`, ...) with a readable
+//! message, the transform is `T R S` with `R = Ry Rx Rz`, and mutated files never panic.
+
+#![allow(clippy::unwrap_used)] // tests may panic
+
+use std::path::PathBuf;
+
+use glam::Vec3;
+use ibl_scene::description::{CompositeRule, MaterialKind, ShapeKind};
+use ibl_scene::{DescriptionError, RenderMode, SceneDescription};
+use rand::{Rng, SeedableRng};
+use rand_pcg::Pcg64;
+
+fn example(name: &str) -> String {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../assets/scenes")
+        .join(name);
+    std::fs::read_to_string(&path).unwrap()
+}
+
+/// The smallest valid scene: a probe, two virtual spheres.
+const BASE: &str = r#"version = 1
+
+[probe]
+file = "p.exr"
+
+[[object]]
+shape = "sphere"
+radius = 0.5
+
+[[object]]
+shape = "sphere"
+radius = 0.25
+translate = [1.0, 0.0, -2.0]
+"#;
+
+/// A `[camera]` viewing the panorama, before any field of the case at hand.
+const CAMERA: &str = r#"
+[camera]
+position = [0.0, 0.0, 0.0]
+look_at = [0.0, 0.0, -1.0]
+"#;
+
+/// The error `text` gives; fails when it parses.
+fn error_of(text: &str) -> DescriptionError {
+    match SceneDescription::from_toml(text) {
+        Ok(_) => panic!("accepted:\n{text}"),
+        Err(e) => e,
+    }
+}
+
+/// `text` is refused with the error at `field`, a message containing `phrase`, and a readable
+/// `field: problem` line (one line, no Rust debug syntax, not too long).
+fn refused(text: &str, field: &str, phrase: &str) {
+    let e = error_of(text);
+    assert_eq!(e.field, field, "{e}\nin:\n{text}");
+    assert!(
+        e.problem.contains(phrase),
+        "{field}: {:?} lacks {phrase:?}",
+        e.problem
+    );
+    let line = e.to_string();
+    assert!(line.starts_with(&format!("{field}: ")), "{line}");
+    assert!(!line.contains('\n') && line.len() < 400, "{line}");
+    assert!(!line.contains("Some(") && !line.contains("None"), "{line}");
+}
+
+#[test]
+fn bundled_examples_parse_and_validate() {
+    for name in ["bunny-sky.toml", "bunny-apartment.toml"] {
+        let d = SceneDescription::from_toml(&example(name)).unwrap();
+        d.validate().unwrap();
+        assert_eq!(d.version, 1, "{name}");
+        assert_eq!(d.render.mode, RenderMode::Reference, "{name}");
+        assert_eq!((d.local.len(), d.object.len()), (1, 1), "{name}");
+        assert_eq!(d.local[0].shape, ShapeKind::Plane, "{name}");
+        assert_eq!(d.object[0].shape, ShapeKind::Mesh, "{name}");
+        let m = d.object[0].material.as_ref().unwrap();
+        assert_eq!(m.kind, MaterialKind::Diffuse, "{name}");
+        assert_eq!(d.camera.as_ref().unwrap().image_size_px, Some([640, 480]));
+    }
+    let sky = SceneDescription::from_toml(&example("bunny-sky.toml")).unwrap();
+    assert_eq!(sky.render.composite, CompositeRule::Ratio);
+}
+
+#[test]
+fn the_example_in_the_user_documentation_parses() {
+    let doc = std::fs::read_to_string(
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../docs/SCENES.md"),
+    )
+    .unwrap();
+    let start = doc.find("```toml\n").unwrap() + "```toml\n".len();
+    let end = start + doc[start..].find("```").unwrap();
+    let d = SceneDescription::from_toml(&doc[start..end]).unwrap();
+    // It is the bundled example, shortened: the same values.
+    let bundled = SceneDescription::from_toml(&example("bunny-sky.toml")).unwrap();
+    assert_eq!(d, bundled);
+}
+
+#[test]
+fn defaults_fill_what_is_left_out() {
+    let d = SceneDescription::from_toml(BASE).unwrap();
+    assert_eq!(d.probe.radiance_scale, 1.0);
+    assert_eq!(d.probe.rotation_deg, [0.0; 3]);
+    assert_eq!(d.probe.position, [0.0; 3]);
+    assert!(d.camera.is_none() && d.local.is_empty());
+    assert_eq!(d.render.mode, RenderMode::Reference);
+    assert_eq!((d.render.spp, d.render.bounces, d.render.seed), (64, 4, 1));
+    assert_eq!(d.render.width, None);
+    assert_eq!(d.render.composite, CompositeRule::Difference);
+    let l = &d.lighting;
+    assert_eq!((l.method.as_str(), l.lights), ("median-cut", 16));
+    assert_eq!((l.ambient_bands, l.ao_samples), (3, 16));
+    assert!(l.lights_file.is_none());
+}
+
+#[test]
+fn transform_is_scale_then_yaw_pitch_roll_then_translate() {
+    // CONVENTIONS section 1: yaw +90 takes -Z to -X, pitch +90 takes -Z to +Y.
+    let text = format!("{BASE}scale = 2.0\nrotate_deg = [90.0, 0.0, 0.0]\n");
+    let d =
+        SceneDescription::from_toml(&text.replace("translate = [1.0, 0.0, -2.0]\n", "")).unwrap();
+    let m = d.object[1].world_from_model();
+    let p = m.transform_point3(Vec3::new(0.0, 0.0, -1.0));
+    assert!(p.distance(Vec3::new(-2.0, 0.0, 0.0)) < 1e-5, "{p}");
+
+    let text = format!("{BASE}scale = [1.0, 3.0, 1.0]\nrotate_deg = [0.0, 90.0, 0.0]\n");
+    let d = SceneDescription::from_toml(&text).unwrap();
+    let m = d.object[1].world_from_model();
+    // (0, 1, -1) -> scale (0, 3, -1) -> pitch +90 about +X (y, z) -> (-z, y): (0, 1, 3)
+    // -> translate (1, 0, -2): (1, 1, 1).
+    let p = m.transform_point3(Vec3::new(0.0, 1.0, -1.0));
+    assert!(p.distance(Vec3::new(1.0, 1.0, 1.0)) < 1e-5, "{p}");
+
+    // Yaw, then pitch, then roll applied right to left: Ry(90) Rx(90) Rz(90) on +X.
+    // Rz(90): +X -> +Y; Rx(90): +Y -> +Z; Ry(90): +Z -> +X.
+    let text = format!("{BASE}rotate_deg = [90.0, 90.0, 90.0]\n");
+    let d =
+        SceneDescription::from_toml(&text.replace("translate = [1.0, 0.0, -2.0]\n", "")).unwrap();
+    let p = d.object[1].world_from_model().transform_vector3(Vec3::X);
+    assert!(p.distance(Vec3::X) < 1e-5, "{p}");
+}
+
+#[test]
+fn unknown_fields_are_named_where_they_are() {
+    refused(
+        &format!("colour = 1\n{BASE}"),
+        "colour",
+        "unknown field `colour`",
+    );
+    // Appended to BASE, a key lands in the second `[[object]]`.
+    refused(
+        &format!("{BASE}colour = 1\n"),
+        "object[1].colour",
+        "unknown field",
+    );
+    refused(
+        &format!("{BASE}[object.material]\nkind = \"diffuse\"\nshine = 3\n"),
+        "object[1].material.shine",
+        "unknown field `shine`",
+    );
+    let first_inline = BASE.replacen(
+        "radius = 0.5\n",
+        "radius = 0.5\nmaterial = { kind = \"glossy\", shine = 3.0 }\n",
+        1,
+    );
+    refused(
+        &first_inline,
+        "object[0].material.shine",
+        "unknown field `shine`",
+    );
+    refused(
+        &format!("{BASE}[render]\nspp = 4\nsamples = 4\n"),
+        "render.samples",
+        "expected one of",
+    );
+    refused(
+        &format!("{BASE}{CAMERA}fov = 40\n"),
+        "camera.fov",
+        "unknown field",
+    );
+    refused(
+        "version = 1\n[probe]\nfile = \"p.exr\"\nrotation = [0, 0, 0]\n",
+        "probe.rotation",
+        "rotation_deg",
+    );
+}
+
+#[test]
+fn missing_and_mistyped_fields_are_named() {
+    refused("version = 1\n", "probe", "missing field `probe`");
+    refused(
+        &format!("{BASE}[[object]]\nradius = 1.0\n"),
+        "object[2].shape",
+        "missing",
+    );
+    refused(
+        &format!("{BASE}material = {{ albedo = [0.5, 0.5, 0.5] }}\n"),
+        "object[1].material.kind",
+        "missing field `kind`",
+    );
+    refused(
+        &format!("{BASE}scale = \"big\"\n"),
+        "object[1].scale",
+        "Scale",
+    );
+    refused(
+        &format!("{BASE}rotate_deg = [1.0, 2.0]\n"),
+        "object[1].rotate_deg",
+        "length",
+    );
+    refused(&format!("{BASE}[render]\nspp = -1\n"), "render.spp", "-1");
+    refused(
+        &format!("{BASE}[render]\nmode = \"fast\"\n"),
+        "render.mode",
+        "`fast`",
+    );
+    refused(
+        &format!("{BASE}[[object]]\nshape = \"cone\"\n"),
+        "object[2].shape",
+        "`cone`",
+    );
+    // A document that is not TOML at all.
+    refused("version = 1\n[probe\n", "toml", "line 2");
+    refused("version = = 1", "toml", "line 1");
+}
+
+#[test]
+fn every_validation_rule_names_its_field() {
+    refused(
+        &BASE.replace("version = 1", "version = 2"),
+        "version",
+        "version 2",
+    );
+    refused(
+        &format!("{BASE}rotate_deg = [0.0, nan, 0.0]\n"),
+        "object[1].rotate_deg",
+        "not finite",
+    );
+    refused(
+        &BASE.replace("[1.0, 0.0, -2.0]", "[nan, 0.0, -2.0]"),
+        "object[1].translate",
+        "not finite",
+    );
+    refused(
+        &format!("{BASE}scale = 0.0\n"),
+        "object[1].scale",
+        "non-zero",
+    );
+    refused(
+        &format!("{BASE}scale = [1.0, 0.0, 1.0]\n"),
+        "object[1].scale[1]",
+        "non-zero",
+    );
+    refused(
+        &format!("{BASE}[[local]]\nshape = \"plane\"\nalbedo = [0.5, 0.5, 0.5]\n"),
+        "local[0].size",
+        "shape \"plane\" needs it",
+    );
+    refused(
+        &format!("{BASE}[[local]]\nshape = \"plane\"\nsize = [1.0, 0.0]\n"),
+        "local[0].size[1]",
+        "positive",
+    );
+    refused(
+        &format!("{BASE}file = \"ball.glb\"\n"),
+        "object[1].file",
+        "does not apply",
+    );
+    refused(
+        &format!("{BASE}[[object]]\nshape = \"mesh\"\n"),
+        "object[2].file",
+        "needs it",
+    );
+    refused(
+        &format!("{BASE}[[object]]\nshape = \"sphere\"\nradius = -1.0\n"),
+        "object[2].radius",
+        "positive",
+    );
+    refused(
+        &format!("{BASE}[[local]]\nshape = \"box\"\nmin = [0, 0, 0]\nmax = [1, 0, 1]\n"),
+        "local[0].max",
+        "exceed min",
+    );
+    refused(
+        &format!("{BASE}[[local]]\nshape = \"plane\"\nsize = [1, 1]\nalbedo = [0.5, 1.2, 0.5]\n"),
+        "local[0].albedo",
+        "[0, 1]",
+    );
+    refused(
+        &format!("{BASE}material = {{ kind = \"diffuse\", albedo = [1.5, 0.5, 0.5] }}\n"),
+        "object[1].material.albedo",
+        "[0, 1]",
+    );
+    refused(
+        &format!(
+            "{BASE}material = {{ kind = \"glossy\", albedo = [0.8, 0.5, 0.5], specular = [0.3, 0.3, 0.3] }}\n"
+        ),
+        "object[1].material",
+        "albedo + specular exceeds 1",
+    );
+    refused(
+        &format!("{BASE}material = {{ kind = \"glossy\", exponent = 0.5 }}\n"),
+        "object[1].material.exponent",
+        "[1, 100000]",
+    );
+    refused(
+        &format!("{BASE}material = {{ kind = \"mirror\", albedo = [0.5, 0.5, 0.5] }}\n"),
+        "object[1].material",
+        "mirror",
+    );
+    refused(
+        &format!(
+            "{BASE}[[local]]\nshape = \"plane\"\nsize = [1, 1]\nmaterial = {{ kind = \"diffuse\" }}\n"
+        ),
+        "local[0].material",
+        "real geometry is diffuse",
+    );
+    refused(
+        &format!("{BASE}albedo_by_group = {{ fur = [0.5, 0.5, 0.5] }}\n"),
+        "object[1].albedo_by_group",
+        "real geometry",
+    );
+    // Backgrounds and cameras.
+    refused(
+        &format!("{BASE}[background]\nkind = \"photo\"\nfile = \"photo.png\"\n"),
+        "camera",
+        "needs a [camera]",
+    );
+    refused(
+        &format!("{BASE}[background]\nkind = \"photo\"\n"),
+        "background.file",
+        "needs a file",
+    );
+    refused(
+        &format!("{BASE}[background]\nfile = \"photo.png\"\n"),
+        "background.file",
+        "kind = \"photo\"",
+    );
+    refused(
+        &format!("{BASE}{CAMERA}vertical_fov_deg = 40.0\n"),
+        "camera.image_size_px",
+        "needs its image size",
+    );
+    refused(
+        &format!(
+            "{BASE}{CAMERA}vertical_fov_deg = 40.0\nfocal_length_px = [500.0, 500.0]\nimage_size_px = [64, 48]\n"
+        ),
+        "camera",
+        "not both",
+    );
+    refused(
+        &format!("{BASE}{CAMERA}image_size_px = [64, 48]\n"),
+        "camera",
+        "needs vertical_fov_deg or focal_length_px",
+    );
+    refused(
+        &format!(
+            "{BASE}{}vertical_fov_deg = 40.0\nimage_size_px = [64, 48]\n",
+            CAMERA.replace("[0.0, 0.0, -1.0]", "[0.0, 0.0, 0.0]")
+        ),
+        "camera.look_at",
+        "equals camera.position",
+    );
+    refused(
+        &format!(
+            "{BASE}{}up = [0.0, 0.0, 2.0]\nvertical_fov_deg = 40.0\nimage_size_px = [64, 48]\n",
+            CAMERA
+        ),
+        "camera.up",
+        "parallel",
+    );
+    refused(
+        &format!("{BASE}{CAMERA}vertical_fov_deg = 180.0\nimage_size_px = [64, 48]\n"),
+        "camera.vertical_fov_deg",
+        "(0, 179)",
+    );
+    refused(
+        &format!(
+            "{BASE}[background]\nkind = \"photo\"\nfile = \"p.png\"\n{CAMERA}vertical_fov_deg = 40.0\nimage_size_px = [64, 48]\n"
+        ),
+        "camera.image_size_px",
+        "photograph's own size",
+    );
+    // Renderer and lighting settings.
+    refused(
+        &format!("{BASE}[render]\nspp = 0\n"),
+        "render.spp",
+        "1..=65536",
+    );
+    refused(
+        &format!("{BASE}[render]\nbounces = 0\n"),
+        "render.bounces",
+        "1..=64",
+    );
+    refused(
+        &format!("{BASE}[render]\nwidth = 1\n"),
+        "render.width",
+        "2..=16384",
+    );
+    refused(
+        &format!("{BASE}[lighting]\nao_samples = 0\n"),
+        "lighting.ao_samples",
+        "1..=1024",
+    );
+    refused(
+        &format!("{BASE}[lighting]\nlights = 0\n"),
+        "lighting.lights",
+        "1..=4096",
+    );
+    refused(
+        &format!("{BASE}[lighting]\nambient_bands = 17\n"),
+        "lighting.ambient_bands",
+        "1..=16",
+    );
+    refused(
+        "version = 1\n[probe]\nfile = \"p.exr\"\nradiance_scale = 0.0\n",
+        "probe.radiance_scale",
+        "positive",
+    );
+}
+
+#[test]
+fn validate_names_the_field_of_a_description_built_in_code() {
+    let mut d = SceneDescription::from_toml(BASE).unwrap();
+    d.object[1].translate = Some([f32::NAN, 0.0, 0.0]);
+    assert_eq!(d.validate().unwrap_err().field, "object[1].translate");
+    let mut d = SceneDescription::from_toml(BASE).unwrap();
+    d.render.spp = 0;
+    assert_eq!(d.validate().unwrap_err().field, "render.spp");
+}
+
+/// The characters that change a TOML document's structure, and a few that break tokens.
+const SPICE: &[u8] = b"[]{}=\"',.#\n\\ 0123456789-+eEinfa_xyz\t\x7f";
+
+#[test]
+fn mutated_scenes_never_panic() {
+    let valid = example("bunny-sky.toml");
+    let bytes = valid.as_bytes();
+    let mut outcomes = [0usize; 2];
+    let mut check = |text: &str| {
+        // Either a scene that validates, or an error that names some field.
+        match SceneDescription::from_toml(text) {
+            Ok(d) => {
+                d.validate().unwrap();
+                outcomes[0] += 1;
+            }
+            Err(e) => {
+                assert!(!e.field.is_empty() && !e.problem.is_empty(), "{e:?}");
+                outcomes[1] += 1;
+            }
+        }
+    };
+    // Every 7th prefix (the file is ASCII, so every prefix is text).
+    for end in (0..=bytes.len()).step_by(7) {
+        check(std::str::from_utf8(&bytes[..end]).unwrap());
+    }
+    // A few bytes replaced, deterministically.
+    let mut rng = Pcg64::seed_from_u64(7);
+    for _ in 0..600 {
+        let mut mutated = bytes.to_vec();
+        for _ in 0..rng.random_range(1..=4) {
+            let at = rng.random_range(0..mutated.len());
+            mutated[at] = if rng.random_bool(0.7) {
+                SPICE[rng.random_range(0..SPICE.len())]
+            } else {
+                rng.random_range(0..0x80)
+            };
+        }
+        check(std::str::from_utf8(&mutated).unwrap());
+    }
+    // Pure noise.
+    for _ in 0..200 {
+        let len = rng.random_range(0..200);
+        let noise: String = (0..len)
+            .map(|_| char::from(SPICE[rng.random_range(0..SPICE.len())]))
+            .collect();
+        check(&noise);
+    }
+    // Most mutations break the file, some (inside comments) do not.
+    assert!(outcomes[0] > 0 && outcomes[1] > 0, "{outcomes:?}");
+}

@@ -1,0 +1,364 @@
+//! The rendering part of `ibl demo`: the bundled example scenes (`assets/scenes/*.toml`: the
+//! bunny in an outdoor probe with a hard sun and in an indoor probe) rendered the ways iblkit
+//! offers, and every light approximation scored by its render against the path-traced reference.
+//!
+//! Per scene, into `renders/<scene>/`: the reference composite (perspective view, several bounces),
+//! the same in the whole panorama, light renders with N = 4, 16 and 64 median-cut lights, the
+//! hybrid (16 lights + SH9 ambient with ambient occlusion), the with/without layers of the
+//! reference; then the study of `ibl_eval::render_study` (methods x N = 1..256 against a direct-
+//! light reference) with its table in `renders/report.md` and its chart as SVG and PNG.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+use ibl_core::{Image, Rgb};
+use ibl_eval::{RenderStudy, RenderStudySettings, render_study};
+use ibl_extract::{Method, ModelSpec};
+use ibl_io::{Display, WriteOptions};
+use ibl_render::lighting::LightingPlan;
+use ibl_render::{RenderOutput, RenderSettings, render};
+use ibl_scene::{Camera, RenderMode, Scene, ShadowKind};
+use serde::Serialize;
+
+use crate::progress;
+
+/// Sub-folder of the renders.
+pub const RENDER_DIR: &str = "renders";
+/// Width of the demo's perspective renders (the scenes' views are 4:3).
+const VIEW_WIDTH: u32 = 320;
+/// Width of the demo's panorama composites.
+const PANORAMA_WIDTH: u32 = 512;
+/// Samples per pixel of the demo's reference renders.
+const SHOWCASE_SPP: u32 = 64;
+/// Samples per pixel of the demo's light and hybrid renders (hard shadows need few).
+const LIGHTS_SPP: u32 = 16;
+/// Light counts of the showcase light renders.
+const SHOWCASE_COUNTS: [usize; 3] = [4, 16, 64];
+/// Width of the study's renders (small: every method at every N is rendered).
+const STUDY_WIDTH: u32 = 128;
+/// Light counts of the study.
+const STUDY_COUNTS: [usize; 9] = [1, 2, 4, 8, 16, 32, 64, 128, 256];
+
+/// One image the demo wrote, for the index page.
+#[derive(Clone, Debug, Serialize)]
+pub struct RenderedImage {
+    /// What it shows.
+    pub caption: String,
+    /// The PNG preview, relative to the demo folder.
+    pub preview: String,
+    /// The EXR, relative to the demo folder.
+    pub exr: String,
+    /// Seconds it took to render.
+    pub seconds: f64,
+}
+
+/// What the demo rendered for one scene.
+#[derive(Clone, Debug, Serialize)]
+pub struct SceneResult {
+    /// Scene name (the file stem).
+    pub name: String,
+    /// The showcase images.
+    pub images: Vec<RenderedImage>,
+    /// The study.
+    pub study: RenderStudy,
+    /// The study's chart (SVG and PNG), relative to the demo folder.
+    pub chart: [String; 2],
+}
+
+/// The example scenes bundled with iblkit.
+pub fn default_scene_dir() -> PathBuf {
+    crate::cmd::demo::assets_dir().join("scenes")
+}
+
+/// The study's methods: the light extraction methods of the paper that make any N, plus median
+/// cut (powers of two).
+fn study_methods() -> Vec<ModelSpec> {
+    [
+        Method::MedianCut,
+        Method::LightGen,
+        Method::IrradianceOptimization,
+    ]
+    .into_iter()
+    .map(ModelSpec::from)
+    .collect()
+}
+
+/// Renders every scene in `dir` into `out/renders/`.
+pub fn demo_renders(dir: &Path, out: &Path) -> anyhow::Result<Vec<SceneResult>> {
+    let mut scenes: Vec<PathBuf> = std::fs::read_dir(dir)
+        .with_context(|| format!("{}: cannot list the example scenes", dir.display()))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    scenes.sort();
+    let mut results = Vec::new();
+    for path in scenes {
+        let name = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        results.push(
+            demo_scene(&path, &name, out)
+                .with_context(|| format!("demo render of {}", path.display()))?,
+        );
+    }
+    let md = results
+        .iter()
+        .map(|r| r.study.markdown())
+        .collect::<Vec<_>>()
+        .join("\n");
+    let report = format!(
+        "# Renders: light approximations against the path-traced reference\n\n\
+         Each light set lights the scene with hard shadows; the reference path-traces the whole \
+         probe with importance sampling and MIS. Both use one bounce (direct light), so the \
+         numbers show what the light set gets wrong about direct light and shadows. The charts \
+         are beside this file.\n\n{md}"
+    );
+    ibl_io::write_atomically(&out.join(RENDER_DIR).join("report.md"), report.as_bytes())?;
+    Ok(results)
+}
+
+fn write_render(
+    out: &Path,
+    dir: &Path,
+    stem: &str,
+    caption: String,
+    image: &Image<Rgb>,
+    display: &WriteOptions,
+    seconds: f64,
+) -> anyhow::Result<RenderedImage> {
+    let exr = dir.join(format!("{stem}.exr"));
+    let png = dir.join(format!("{stem}.png"));
+    ibl_io::write_image(&exr, image, &WriteOptions::default())?;
+    ibl_io::write_image(&png, image, display)?;
+    Ok(RenderedImage {
+        caption,
+        preview: crate::cmd::demo::relative(out, &png),
+        exr: crate::cmd::demo::relative(out, &exr),
+        seconds,
+    })
+}
+
+fn timed_render(
+    scene: &Scene,
+    plan: &LightingPlan,
+    settings: &RenderSettings,
+) -> anyhow::Result<(RenderOutput, f64)> {
+    let started = std::time::Instant::now();
+    let (lighting, _) = plan.build(scene)?;
+    let output = render(scene, &lighting, settings, &|_, _| {})?;
+    Ok((output, started.elapsed().as_secs_f64()))
+}
+
+fn demo_scene(path: &Path, name: &str, out: &Path) -> anyhow::Result<SceneResult> {
+    let loaded = ibl_io::read_scene(path)?;
+    let scene = loaded.scene;
+    let dir = out.join(RENDER_DIR).join(name);
+    std::fs::create_dir_all(&dir).with_context(|| format!("{}: cannot create", dir.display()))?;
+    let bar = progress::bar(name, (SHOWCASE_COUNTS.len() + 3) as u64);
+    let settings = RenderSettings {
+        composite: scene.render.composite,
+        width: Some(VIEW_WIDTH),
+        spp: SHOWCASE_SPP,
+        bounces: scene.render.bounces,
+        seed: scene.render.seed,
+    };
+    let base = LightingPlan::from_scene(&scene);
+    let mut images = Vec::new();
+
+    // The reference, its layers, and the exposure every preview of the scene shares.
+    let reference_plan = LightingPlan {
+        mode: RenderMode::Reference,
+        ..base.clone()
+    };
+    let (reference, seconds) = timed_render(&scene, &reference_plan, &settings)?;
+    let display = WriteOptions {
+        display: Display {
+            exposure_stops: ibl_io::tonemap::auto_exposure_stops(&reference.background),
+            ..Display::default()
+        },
+        ..WriteOptions::default()
+    };
+    let mut add =
+        |stem: &str, caption: String, image: &Image<Rgb>, seconds: f64| -> anyhow::Result<()> {
+            images.push(write_render(
+                out, &dir, stem, caption, image, &display, seconds,
+            )?);
+            Ok(())
+        };
+    add(
+        "reference",
+        format!(
+            "reference: path-traced, {} spp, {} bounces, composited ({})",
+            settings.spp,
+            settings.bounces,
+            settings.composite.name()
+        ),
+        &reference.composite,
+        seconds,
+    )?;
+    add(
+        "reference-with",
+        "local scene with the bunny".into(),
+        &reference.with_objects,
+        0.0,
+    )?;
+    add(
+        "reference-without",
+        "local scene without it".into(),
+        &reference.without_objects,
+        0.0,
+    )?;
+    add(
+        "background",
+        "background".into(),
+        &reference.background,
+        0.0,
+    )?;
+    bar.inc(1);
+
+    let lights_settings = RenderSettings {
+        spp: LIGHTS_SPP,
+        ..settings
+    };
+    for n in SHOWCASE_COUNTS {
+        let plan = LightingPlan {
+            mode: RenderMode::Lights,
+            method: "median-cut".into(),
+            lights: n,
+            shadows: ShadowKind::Hard,
+            ..base.clone()
+        };
+        let (output, seconds) = timed_render(&scene, &plan, &lights_settings)?;
+        add(
+            &format!("lights-median-cut-{n}"),
+            format!("{n} median-cut lights, hard shadows, {LIGHTS_SPP} spp"),
+            &output.composite,
+            seconds,
+        )?;
+        bar.inc(1);
+    }
+    let hybrid_plan = LightingPlan {
+        mode: RenderMode::Hybrid,
+        method: "median-cut".into(),
+        lights: 16,
+        ..base.clone()
+    };
+    let (hybrid, seconds) = timed_render(&scene, &hybrid_plan, &lights_settings)?;
+    add(
+        "hybrid",
+        format!(
+            "hybrid: 16 median-cut lights + SH{} ambient, {} occlusion rays, {LIGHTS_SPP} spp",
+            hybrid_plan.ambient_bands * hybrid_plan.ambient_bands,
+            hybrid_plan.occlusion_rays
+        ),
+        &hybrid.composite,
+        seconds,
+    )?;
+    bar.inc(1);
+
+    // The whole panorama, when the background is the probe.
+    if matches!(scene.background, ibl_scene::Background::Panorama) {
+        let mut panorama = scene.clone();
+        panorama.camera = Camera::Panorama {
+            position: scene.probe.position,
+            world_from_probe: scene.probe.world_from_probe,
+        };
+        let pano_settings = RenderSettings {
+            width: Some(PANORAMA_WIDTH),
+            spp: SHOWCASE_SPP / 4,
+            ..settings
+        };
+        let (output, seconds) = timed_render(&panorama, &reference_plan, &pano_settings)?;
+        add(
+            "panorama",
+            format!("the whole panorama, reference, {} spp", pano_settings.spp),
+            &output.composite,
+            seconds,
+        )?;
+    }
+    bar.inc(1);
+    bar.finish_and_clear();
+
+    // The study: every method at every N against a direct-light reference.
+    let study_settings = RenderStudySettings {
+        methods: study_methods(),
+        counts: STUDY_COUNTS.to_vec(),
+        width: Some(STUDY_WIDTH),
+        reference_spp: 512,
+        lights_spp: 4,
+        bounces: 1,
+        shadows: ShadowKind::Hard,
+        seed: scene.render.seed,
+    };
+    let runs = study_settings.methods.len() * study_settings.counts.len() + 2;
+    let bar = progress::bar(&format!("{name}: study"), runs as u64);
+    let (study, study_images) = render_study(
+        &scene,
+        name,
+        &study_settings,
+        &progress::rows_callback(&bar),
+    )?;
+    bar.finish_and_clear();
+    let study_dir = dir.join("study");
+    std::fs::create_dir_all(&study_dir)
+        .with_context(|| format!("{}: cannot create", study_dir.display()))?;
+    ibl_io::write_image(
+        &study_dir.join("reference.png"),
+        &study_images.reference.with_objects,
+        &display,
+    )?;
+    for (method, n, output) in &study_images.lights {
+        ibl_io::write_image(
+            &study_dir.join(format!("{method}-{n}.png")),
+            &output.with_objects,
+            &display,
+        )?;
+    }
+    let chart = study.chart();
+    let svg = ibl_eval::render_svg(&chart, ibl_eval::PLOT_SIZE)?;
+    let svg_path = out.join(RENDER_DIR).join(format!("{name}-study.svg"));
+    ibl_io::write_atomically(&svg_path, svg.as_bytes())?;
+    let png = ibl_io::ldr::encode_png(&ibl_eval::render_png(&chart, ibl_eval::PLOT_SIZE)?)
+        .context("encoding the study chart")?;
+    let png_path = out.join(RENDER_DIR).join(format!("{name}-study.png"));
+    ibl_io::write_atomically(&png_path, &png)?;
+    Ok(SceneResult {
+        name: name.to_string(),
+        images,
+        study,
+        chart: [
+            crate::cmd::demo::relative(out, &svg_path),
+            crate::cmd::demo::relative(out, &png_path),
+        ],
+    })
+}
+
+/// The renders section of the demo's `index.html`.
+pub fn renders_html(results: &[SceneResult]) -> String {
+    let mut html = String::from(
+        "<h1 id=renders>Virtual objects in real probes</h1>\
+         <p>The example scenes of <code>assets/scenes/</code>, rendered by <code>ibl render</code>: \
+         the path-traced reference composited into the probe by differential rendering, light \
+         approximations, the hybrid, and the whole panorama. Then every light set scored by its \
+         render against the reference (<a href=\"renders/report.md\">renders/report.md</a>).</p>",
+    );
+    for r in results {
+        let _ = write!(html, "<h2>{}</h2>", r.name);
+        for image in &r.images {
+            let time = if image.seconds > 0.0 {
+                format!(" ({:.1} s)", image.seconds)
+            } else {
+                String::new()
+            };
+            let _ = write!(
+                html,
+                "<figure><img src=\"{}\"><figcaption>{}{time}</figcaption></figure>",
+                image.preview, image.caption
+            );
+        }
+        let _ = write!(html, "<p><img class=wide src=\"{}\"></p>", r.chart[1]);
+    }
+    html
+}
