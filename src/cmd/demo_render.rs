@@ -51,6 +51,9 @@ pub struct RenderedImage {
     pub exr: String,
     /// Seconds it took to render.
     pub seconds: f64,
+    /// Relative MSE and mean FLIP of the composite against the reference composite (light and
+    /// hybrid renders only).
+    pub against_reference: Option<(f64, f64)>,
 }
 
 /// What the demo rendered for one scene.
@@ -71,17 +74,16 @@ pub fn default_scene_dir() -> PathBuf {
     crate::cmd::demo::assets_dir().join("scenes")
 }
 
-/// The study's methods: the light extraction methods of the paper that make any N, plus median
-/// cut (powers of two).
+/// The study's methods: every light extraction method (median cut only at powers of two).
 fn study_methods() -> Vec<ModelSpec> {
-    [
-        Method::MedianCut,
-        Method::LightGen,
-        Method::IrradianceOptimization,
-    ]
-    .into_iter()
-    .map(ModelSpec::from)
-    .collect()
+    Method::ALL.into_iter().map(ModelSpec::from).collect()
+}
+
+/// Relative MSE and mean FLIP of `test` against `reference`.
+fn against(test: &Image<Rgb>, reference: &Image<Rgb>) -> anyhow::Result<(f64, f64)> {
+    let d = ibl_eval::ImageDifference::between(test, reference, None)?;
+    let f = ibl_eval::flip(test, reference, &ibl_eval::FlipOptions::default())?;
+    Ok((d.relative_mse, f.mean()))
 }
 
 /// Renders every scene in `dir` into `out/renders/`.
@@ -105,18 +107,43 @@ pub fn demo_renders(dir: &Path, out: &Path) -> anyhow::Result<Vec<SceneResult>> 
     }
     let md = results
         .iter()
-        .map(|r| r.study.markdown())
+        .map(|r| format!("{}\n{}", showcase_markdown(r), r.study.markdown()))
         .collect::<Vec<_>>()
         .join("\n");
     let report = format!(
         "# Renders: light approximations against the path-traced reference\n\n\
-         Each light set lights the scene with hard shadows; the reference path-traces the whole \
-         probe with importance sampling and MIS. Both use one bounce (direct light), so the \
-         numbers show what the light set gets wrong about direct light and shadows. The charts \
-         are beside this file.\n\n{md}"
+         Per scene: the showcase renders (composites, the reference's bounces) with their error \
+         against the reference composite; then the study, where every method at every N lights \
+         the scene with hard shadows against a path-traced reference of the whole probe \
+         (importance sampling and MIS), both with one bounce (direct light), so the numbers show \
+         what a light set gets wrong about direct light and shadows. The charts are beside this \
+         file.\n\n{md}"
     );
     ibl_io::write_atomically(&out.join(RENDER_DIR).join("report.md"), report.as_bytes())?;
     Ok(results)
+}
+
+/// The showcase renders of a scene and their error against its reference, as Markdown.
+fn showcase_markdown(r: &SceneResult) -> String {
+    let mut md = format!(
+        "## {}\n\n| image | seconds | relative MSE vs reference | FLIP vs reference |\n|---|---:|---:|---:|\n",
+        r.name
+    );
+    for image in &r.images {
+        let (relative_mse, flip) = image
+            .against_reference
+            .map_or(("-".to_string(), "-".to_string()), |(e, f)| {
+                (format!("{e:.2e}"), format!("{f:.3}"))
+            });
+        let _ = writeln!(
+            md,
+            "| [{}]({}) | {:.1} | {relative_mse} | {flip} |",
+            image.caption,
+            image.preview.trim_start_matches("renders/"),
+            image.seconds
+        );
+    }
+    md
 }
 
 fn write_render(
@@ -137,6 +164,7 @@ fn write_render(
         preview: crate::cmd::demo::relative(out, &png),
         exr: crate::cmd::demo::relative(out, &exr),
         seconds,
+        against_reference: None,
     })
 }
 
@@ -180,13 +208,19 @@ fn demo_scene(path: &Path, name: &str, out: &Path) -> anyhow::Result<SceneResult
         },
         ..WriteOptions::default()
     };
-    let mut add =
-        |stem: &str, caption: String, image: &Image<Rgb>, seconds: f64| -> anyhow::Result<()> {
-            images.push(write_render(
-                out, &dir, stem, caption, image, &display, seconds,
-            )?);
-            Ok(())
-        };
+    let reference_composite = reference.composite.clone();
+    // Writes an image; light and hybrid renders also get their error against the reference.
+    let mut add = |stem: &str,
+                   caption: String,
+                   image: &Image<Rgb>,
+                   seconds: f64,
+                   error: Option<(f64, f64)>|
+     -> anyhow::Result<()> {
+        let mut written = write_render(out, &dir, stem, caption, image, &display, seconds)?;
+        written.against_reference = error;
+        images.push(written);
+        Ok(())
+    };
     add(
         "reference",
         format!(
@@ -197,24 +231,28 @@ fn demo_scene(path: &Path, name: &str, out: &Path) -> anyhow::Result<SceneResult
         ),
         &reference.composite,
         seconds,
+        None,
     )?;
     add(
         "reference-with",
         "local scene with the bunny".into(),
         &reference.with_objects,
         0.0,
+        None,
     )?;
     add(
         "reference-without",
         "local scene without it".into(),
         &reference.without_objects,
         0.0,
+        None,
     )?;
     add(
         "background",
         "background".into(),
         &reference.background,
         0.0,
+        None,
     )?;
     bar.inc(1);
 
@@ -236,6 +274,7 @@ fn demo_scene(path: &Path, name: &str, out: &Path) -> anyhow::Result<SceneResult
             format!("{n} median-cut lights, hard shadows, {LIGHTS_SPP} spp"),
             &output.composite,
             seconds,
+            Some(against(&output.composite, &reference_composite)?),
         )?;
         bar.inc(1);
     }
@@ -255,6 +294,7 @@ fn demo_scene(path: &Path, name: &str, out: &Path) -> anyhow::Result<SceneResult
         ),
         &hybrid.composite,
         seconds,
+        Some(against(&hybrid.composite, &reference_composite)?),
     )?;
     bar.inc(1);
 
@@ -276,6 +316,7 @@ fn demo_scene(path: &Path, name: &str, out: &Path) -> anyhow::Result<SceneResult
             format!("the whole panorama, reference, {} spp", pano_settings.spp),
             &output.composite,
             seconds,
+            None,
         )?;
     }
     bar.inc(1);
@@ -352,9 +393,17 @@ pub fn renders_html(results: &[SceneResult]) -> String {
             } else {
                 String::new()
             };
+            let error = image
+                .against_reference
+                .map(|(relative_mse, flip)| {
+                    format!(
+                        "<br>against the reference: relative MSE {relative_mse:.2e}, FLIP {flip:.3}"
+                    )
+                })
+                .unwrap_or_default();
             let _ = write!(
                 html,
-                "<figure><img src=\"{}\"><figcaption>{}{time}</figcaption></figure>",
+                "<figure><img src=\"{}\"><figcaption>{}{time}{error}</figcaption></figure>",
                 image.preview, image.caption
             );
         }

@@ -14,7 +14,7 @@
 //! * [`overlay`]: light sets drawn over their probe;
 //! * [`image_difference`]: RMSE, relative MSE, absolute errors and error maps between two images;
 //! * [`mod@flip`]: the FLIP perceptual difference map (Andersson et al. 2020, HDR-FLIP 2021);
-//! * [`render_study`]: light sets judged by their renders against the path-traced reference.
+//! * [`mod@render_study`]: light sets judged by their renders against the path-traced reference.
 //!
 //! Nothing here reads or writes files: outputs are strings and 8-bit images in memory.
 //!

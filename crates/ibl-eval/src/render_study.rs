@@ -2,7 +2,7 @@
 //! methods are compared on renders with shadows as well as on irradiance): for one scene, the
 //! path-traced reference, then for every method and light count N a render in the `lights` mode,
 //! each scored against the reference by relative MSE (mean of `(a - b)^2 / (b^2 + 0.01)` over
-//! pixels and channels) and by FLIP ([`crate::flip`]).
+//! pixels and channels) and by FLIP ([`mod@crate::flip`]).
 //!
 //! What is compared is the rendered local scene *with* the objects (ground, object and its
 //! shadow, background where the camera sees no geometry), so every approximation is judged on

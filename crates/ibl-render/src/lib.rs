@@ -2,7 +2,7 @@
 //! by differential rendering (Debevec 1998; Grosch 2005 section 4.1; Madsen & Laursen 2006 use it
 //! to compare light approximations).
 //!
-//! - [`render`]: the driver and the differential composite (with and without the objects).
+//! - [`mod@render`]: the driver and the differential composite (with and without the objects).
 //! - [`tracer`]: one light path, in the reference, lights or hybrid mode.
 //! - [`lighting`]: what lights each mode (environment, directional lights, lights + SH ambient).
 //! - [`background`]: the background at the output size.
