@@ -297,7 +297,7 @@ fn demo_writes_every_mapping_and_an_index() {
     assert!(out_dir.join("index.html").exists());
     let summary: serde_json::Value =
         serde_json::from_slice(&std::fs::read(out_dir.join("summary.json")).unwrap()).unwrap();
-    let probes = summary.as_array().unwrap();
+    let probes = summary["probes"].as_array().unwrap();
     assert_eq!(probes.len(), 5);
     for p in probes {
         for m in p["mappings"].as_array().unwrap() {
@@ -327,6 +327,52 @@ fn demo_writes_every_mapping_and_an_index() {
     }
     let sky = probes.iter().find(|p| p["name"] == "sky").unwrap();
     assert!(sky["irradiance"]["sun_confidence"].as_f64().unwrap() > 0.5);
+
+    // The example scenes: every image written, light and hybrid renders scored, and in the study
+    // every method's light renders closer to the reference at N = 256 than at N = 1 (falling to
+    // within a few times the reference's own noise).
+    assert!(out_dir.join("renders/report.md").exists());
+    let renders = summary["renders"].as_array().unwrap();
+    assert_eq!(renders.len(), 2);
+    for r in renders {
+        for image in r["images"].as_array().unwrap() {
+            assert!(out_dir.join(image["preview"].as_str().unwrap()).exists());
+            assert!(out_dir.join(image["exr"].as_str().unwrap()).exists());
+        }
+        let scored = r["images"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|i| !i["against_reference"].is_null())
+            .count();
+        assert_eq!(scored, 4, "{}: 3 light renders and the hybrid", r["name"]);
+        for chart in r["chart"].as_array().unwrap() {
+            assert!(out_dir.join(chart.as_str().unwrap()).exists());
+        }
+        let study = &r["study"];
+        let floor = study["noise_floor_relative_mse"].as_f64().unwrap();
+        let rows = study["rows"].as_array().unwrap();
+        let error = |method: &str, n: u64| {
+            rows.iter()
+                .find(|row| row["method"] == method && row["n"] == n)
+                .and_then(|row| row["relative_mse"].as_f64())
+                .unwrap()
+        };
+        for method in [
+            "median-cut",
+            "adaptive-median-cut",
+            "lightgen",
+            "variance-minimization",
+            "irradiance-optimization",
+        ] {
+            let (first, last) = (error(method, 1), error(method, 256));
+            assert!(
+                last < first / 10.0 && last < 10.0 * floor,
+                "{} {method}: relative MSE {first} at N = 1, {last} at N = 256 (floor {floor})",
+                r["name"]
+            );
+        }
+    }
 }
 
 #[test]

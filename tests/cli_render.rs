@@ -433,3 +433,98 @@ fn outputs_never_overwrite_an_input() {
     assert_eq!(std::fs::read(f.path("ldr.png")).unwrap(), png_before);
     assert!(!f.path("ldr.exr").exists() && !f.path("view.exr").exists());
 }
+
+/// A photograph background: the scene of the other tests seen through a pinhole camera whose
+/// intrinsics are in pixels of a 48 x 36 photo (an EXR written here).
+const PHOTO_SCENE: &str = r#"version = 1
+
+[probe]
+file = "sky.exr"
+
+[background]
+kind = "photo"
+file = "photo.exr"
+
+[camera]
+position = [0.0, 0.0, 0.0]
+look_at = [0.0, -0.75, -1.2]
+focal_length_px = [66.0, 66.0]
+principal_point_px = [24.0, 18.0]
+
+[[local]]
+shape = "plane"
+center = [0.0, -1.0, 0.0]
+size = [10.0, 10.0]
+albedo = [0.3, 0.3, 0.3]
+
+OBJECTS
+
+[render]
+spp = 2
+bounces = 2
+"#;
+
+#[test]
+fn a_photo_background_composites_back_to_the_photo_when_empty() {
+    let f = Fixture::new();
+    // A photo with a distinct value in every pixel and channel.
+    let photo = Image::from_fn_par(48, 36, |x, y| {
+        Rgb::new(
+            0.1 + x as f32 / 97.0,
+            0.2 + y as f32 / 53.0,
+            0.05 + (x * y) as f32 / 3001.0,
+        )
+    });
+    ibl_io::write_image(&f.path("photo.exr"), &photo, &Default::default()).unwrap();
+    f.write("empty.toml", PHOTO_SCENE.replace("OBJECTS", "").as_bytes());
+    let o = ibl(&[
+        "render",
+        &s(&f.path("empty.toml")),
+        "-o",
+        &s(&f.path("empty.exr")),
+        "--spp",
+        "2",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = image(&f.path("empty.exr"));
+    assert_eq!((out.width(), out.height()), (48, 36));
+    for (a, b) in out.pixels().iter().zip(photo.pixels()) {
+        for c in 0..3 {
+            assert_eq!(
+                a[c].to_bits(),
+                b[c].to_bits(),
+                "empty scene must return the photo"
+            );
+        }
+    }
+    // With the bunny: its pixels change, the photo's corners (far from it and its shadow) do not.
+    let bunny = "[[object]]\nshape = \"mesh\"\nfile = \"bunny.glb\"\nscale = 0.25\n\
+                 translate = [0.0, -0.777, -1.2]\n";
+    f.write(
+        "bunny.toml",
+        PHOTO_SCENE.replace("OBJECTS", bunny).as_bytes(),
+    );
+    let o = ibl(&[
+        "render",
+        &s(&f.path("bunny.toml")),
+        "-o",
+        &s(&f.path("bunny.exr")),
+        "--mode",
+        "lights",
+        "-n",
+        "4",
+        "--json",
+    ]);
+    let v = summary(&o, "lights", (48, 36));
+    assert!(v["object_coverage"].as_f64().unwrap() > 0.01);
+    let out = image(&f.path("bunny.exr"));
+    let changed = out
+        .pixels()
+        .iter()
+        .zip(photo.pixels())
+        .filter(|(a, b)| a != b)
+        .count();
+    assert!(changed > 20, "{changed} pixels changed");
+    assert_eq!(out.get(0, 0), photo.get(0, 0));
+    assert_eq!(out.get(47, 0), photo.get(47, 0));
+}

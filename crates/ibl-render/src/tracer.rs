@@ -220,16 +220,14 @@ impl<'a> Tracer<'a> {
         let env = &self.lighting.environment;
         let sample = env.sample(rng.next_f32(), rng.next_f32());
         let wi = sample.direction;
-        let cos = surface.shading_normal.dot(wi);
-        if cos <= 0.0 || sample.pdf_sr <= 0.0 || surface.geometric_normal.dot(wi) <= 0.0 {
+        if sample.pdf_sr <= 0.0 {
             return Rgb::ZERO;
         }
-        let f = bsdf.eval(wo, wi);
-        if f.max_channel() <= 0.0 || self.occluded(surface, wi, state) {
+        let Some(f_cos) = self.unblocked_reflection(surface, bsdf, wo, wi, state) else {
             return Rgb::ZERO;
-        }
+        };
         let weight = power_heuristic(sample.pdf_sr, bsdf.pdf(wo, wi));
-        f * sample.radiance * (cos * weight / sample.pdf_sr)
+        f_cos * sample.radiance * (weight / sample.pdf_sr)
     }
 
     /// Directional lights: all of them at the first vertex, one chosen by power later.
@@ -278,15 +276,29 @@ impl<'a> Tracer<'a> {
             }
             _ => light.direction,
         };
+        self.unblocked_reflection(surface, bsdf, wo, wi, state)
+            .map_or(Rgb::ZERO, |f_cos| f_cos * light.irradiance)
+    }
+
+    /// `f(wo, wi) cos(theta_i)` for light arriving from `wi`, or `None` when the surface cannot
+    /// reflect it (below the shading or geometric surface, a zero BSDF) or something blocks it.
+    fn unblocked_reflection(
+        &self,
+        surface: &SurfacePoint,
+        bsdf: &Bsdf,
+        wo: Vec3,
+        wi: Vec3,
+        state: &mut PathState,
+    ) -> Option<Rgb> {
         let cos = surface.shading_normal.dot(wi);
         if cos <= 0.0 || surface.geometric_normal.dot(wi) <= 0.0 {
-            return Rgb::ZERO;
+            return None;
         }
         let f = bsdf.eval(wo, wi);
         if f.max_channel() <= 0.0 || self.occluded(surface, wi, state) {
-            return Rgb::ZERO;
+            return None;
         }
-        f * light.irradiance * cos
+        Some(f * cos)
     }
 
     /// The hybrid ambient: `albedo / pi * E_ambient(n) * visibility`, visibility the fraction of

@@ -881,3 +881,45 @@ fn more_median_cut_lights_converge_to_the_reference() {
         "relative MSE by N: {errors:?}"
     );
 }
+
+#[test]
+fn a_mirror_sphere_reflects_the_environment_in_every_mode() {
+    // Closed form: a convex mirror of reflectance R in a constant environment L shows R L at every
+    // pixel it covers (each reflected ray escapes; the mirror is a delta lobe, so no sampling
+    // noise). Every mode sends mirror rays to the probe itself, so lights and hybrid agree with
+    // the reference exactly there. Pixels the sphere only partly covers mix R L and L.
+    let l = Rgb::new(0.75, 0.5, 0.25);
+    let scene = furnace_scene(l, r#"{ kind = "mirror", specular = [0.5, 0.25, 1.0] }"#);
+    let expected = Rgb::new(0.5 * 0.75, 0.25 * 0.5, 0.25);
+    let reference = Lighting::reference(&scene).unwrap();
+    let lights = plan(RenderMode::Lights, 4, ShadowKind::Hard)
+        .build(&scene)
+        .unwrap()
+        .0;
+    let hybrid = plan(RenderMode::Hybrid, 4, ShadowKind::Hard)
+        .build(&scene)
+        .unwrap()
+        .0;
+    for lighting in [reference, lights, hybrid] {
+        let out = run(
+            &scene,
+            &lighting,
+            &settings(4, 4, 3, CompositeRule::Difference),
+        );
+        let mut covered = 0;
+        for (p, &c) in out
+            .with_objects
+            .pixels()
+            .iter()
+            .zip(out.object_coverage.pixels())
+        {
+            if c == 1.0 {
+                covered += 1;
+                for k in 0..3 {
+                    assert!((p[k] - expected[k]).abs() < 1e-6, "{p:?} vs {expected:?}");
+                }
+            }
+        }
+        assert!(covered > 700, "{covered} mirror pixels");
+    }
+}

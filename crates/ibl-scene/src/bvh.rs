@@ -202,6 +202,24 @@ enum Split {
     Median { axis: usize },
 }
 
+/// The build's primitives: each triangle's bounds and input index.
+fn prims(triangles: &[[Vec3; 3]]) -> Vec<Prim> {
+    triangles
+        .iter()
+        .enumerate()
+        .map(|(i, &[a, b, c])| {
+            let (a, b, c) = (Vec3A::from(a), Vec3A::from(b), Vec3A::from(c));
+            Prim {
+                bounds: Aabb {
+                    lo: a.min(b).min(c),
+                    hi: a.max(b).max(c),
+                },
+                index: i as u32,
+            }
+        })
+        .collect()
+}
+
 impl Bvh {
     /// Builds the hierarchy over `triangles`, each given by its three corners in the world frame;
     /// `Hit::triangle` refers to positions in this slice (so at most `u32::MAX` triangles).
@@ -212,20 +230,7 @@ impl Bvh {
         if triangles.is_empty() {
             return Bvh::default();
         }
-        let mut prims: Vec<Prim> = triangles
-            .iter()
-            .enumerate()
-            .map(|(i, &[a, b, c])| {
-                let (a, b, c) = (Vec3A::from(a), Vec3A::from(b), Vec3A::from(c));
-                Prim {
-                    bounds: Aabb {
-                        lo: a.min(b).min(c),
-                        hi: a.max(b).max(c),
-                    },
-                    index: i as u32,
-                }
-            })
-            .collect();
+        let mut prims = prims(triangles);
         let tree = build(&mut prims, 0, 0);
         let mut pairs = Vec::with_capacity(tree.inner);
         let root = flatten(&tree.node, &mut pairs);
@@ -857,20 +862,7 @@ mod tests {
     #[test]
     fn below_the_sah_depth_limit_median_splits_halve_the_count() {
         let tris = soup(10_000, 5);
-        let mut prims: Vec<Prim> = tris
-            .iter()
-            .enumerate()
-            .map(|(i, &[a, b, c])| {
-                let (a, b, c) = (Vec3A::from(a), Vec3A::from(b), Vec3A::from(c));
-                Prim {
-                    bounds: Aabb {
-                        lo: a.min(b).min(c),
-                        hi: a.max(b).max(c),
-                    },
-                    index: i as u32,
-                }
-            })
-            .collect();
+        let mut prims = prims(&tris);
         // 10000 -> 5000 -> ... -> 10 -> 5 -> 3: 12 splits, 13 nodes on every path.
         let tree = build(&mut prims, 0, SAH_MAX_DEPTH);
         assert_eq!(tree.depth, 13);
