@@ -48,6 +48,8 @@ enum Command {
     Eval(cmd::eval::EvalArgs),
     /// Error metrics of an image against a reference: RMSE, relative MSE, FLIP; error images.
     Compare(cmd::compare::CompareArgs),
+    /// Make a probe with a camera: merge brackets, unwrap mirror balls, stitch fisheyes.
+    Capture(cmd::capture::CaptureArgs),
     /// Render virtual objects into the probe panorama or a photo (reference, lights, hybrid).
     Render(cmd::render::RenderArgs),
     /// Write a tone-mapped 8-bit preview (PNG or JPEG) of an HDR image.
@@ -78,6 +80,7 @@ fn main() -> ExitCode {
         Command::Eval(args) => cmd::eval::run(&args),
         Command::Compare(args) => cmd::compare::run(&args),
         Command::Render(args) => cmd::render::run(&args),
+        Command::Capture(args) => cmd::capture::run(&args),
         Command::Preview(args) => cmd::preview::run(&args),
         Command::Demo(args) => cmd::demo::run(&args),
     };

@@ -14,7 +14,8 @@
 //! * [`overlay`]: light sets drawn over their probe;
 //! * [`image_difference`]: RMSE, relative MSE, absolute errors and error maps between two images;
 //! * [`mod@flip`]: the FLIP perceptual difference map (Andersson et al. 2020, HDR-FLIP 2021);
-//! * [`mod@render_study`]: light sets judged by their renders against the path-traced reference.
+//! * [`mod@render_study`]: light sets judged by their renders against the path-traced reference;
+//! * [`response_plot`]: camera response curves as charts.
 //!
 //! Nothing here reads or writes files: outputs are strings and 8-bit images in memory.
 //!
@@ -28,6 +29,7 @@ pub mod overlay;
 pub mod plot;
 pub mod render_study;
 pub mod report;
+pub mod response_plot;
 pub mod sphere_image;
 pub mod sweep;
 

@@ -26,6 +26,7 @@ pub mod light_export;
 pub mod light_file;
 pub mod mesh_file;
 pub mod pfm;
+pub mod photo;
 pub mod sanitize;
 pub mod scene_file;
 pub mod sh_file;
