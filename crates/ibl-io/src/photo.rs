@@ -134,4 +134,39 @@ mod tests {
         assert_eq!(exif_exposure_time(&png), None);
         assert!(decode_codes(b"not an image", &Limits::default()).is_err());
     }
+
+    /// A JPEG with an EXIF `ExposureTime` of 1/250 s: the APP1 segment (`Exif\0\0` + a TIFF
+    /// block made by kamadak-exif's writer) inserted after the JPEG's start-of-image marker.
+    fn jpeg_with_exposure(numerator: u32, denominator: u32) -> Vec<u8> {
+        let image = Image::from_fn_par(16, 8, |x, y| [(x * 16) as u8, (y * 32) as u8, 128]);
+        let jpeg = crate::ldr::encode_jpeg(&image, 90).unwrap();
+        let field = exif::Field {
+            tag: exif::Tag::ExposureTime,
+            ifd_num: exif::In::PRIMARY,
+            value: exif::Value::Rational(vec![exif::Rational::from((numerator, denominator))]),
+        };
+        let mut writer = exif::experimental::Writer::new();
+        writer.push_field(&field);
+        let mut tiff = std::io::Cursor::new(Vec::new());
+        writer.write(&mut tiff, false).unwrap();
+        let mut payload = b"Exif\0\0".to_vec();
+        payload.extend_from_slice(&tiff.into_inner());
+        let length = u16::try_from(payload.len() + 2).unwrap();
+        let mut out = jpeg[..2].to_vec();
+        out.extend_from_slice(&[0xFF, 0xE1]);
+        out.extend_from_slice(&length.to_be_bytes());
+        out.extend_from_slice(&payload);
+        out.extend_from_slice(&jpeg[2..]);
+        out
+    }
+
+    #[test]
+    fn exif_exposure_time_is_read_from_a_jpeg() {
+        let jpeg = jpeg_with_exposure(1, 250);
+        assert_eq!(exif_exposure_time(&jpeg), Some(0.004));
+        let codes = decode_codes(&jpeg, &Limits::default()).unwrap();
+        assert_eq!((codes.width(), codes.height()), (16, 8));
+        // A zero exposure time is no exposure time.
+        assert_eq!(exif_exposure_time(&jpeg_with_exposure(0, 1)), None);
+    }
 }
