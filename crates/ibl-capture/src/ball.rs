@@ -354,16 +354,9 @@ fn centre_peaks(edges: &[EdgePoint], w: usize, h: usize, r_max: f64) -> Vec<(f64
     let mut peaks = Vec::new();
     let reach = MIN_RADIUS as isize;
     for _ in 0..PEAKS {
-        let Some((k, &best)) = smooth
-            .iter()
-            .enumerate()
-            .max_by(|a, b| a.1.cmp(b.1).then(b.0.cmp(&a.0)))
-        else {
+        let Some(k) = strongest(&smooth) else {
             break;
         };
-        if best == 0 {
-            break;
-        }
         let (i, j) = ((k % w) as isize, (k / w) as isize);
         // Centroid of the raw votes around the peak: sub-cell centre.
         let (mut sx, mut sy, mut sw) = (0.0, 0.0, 0.0);
@@ -383,6 +376,15 @@ fn centre_peaks(edges: &[EdgePoint], w: usize, h: usize, r_max: f64) -> Vec<(f64
         }
     }
     peaks
+}
+
+/// Index of the largest positive count (the first of equals); `None` when every count is 0.
+fn strongest(counts: &[u32]) -> Option<usize> {
+    let (k, &best) = counts
+        .iter()
+        .enumerate()
+        .max_by(|a, b| a.1.cmp(b.1).then(b.0.cmp(&a.0)))?;
+    (best > 0).then_some(k)
 }
 
 /// The two most common radii (1-pixel bins smoothed by `[1, 2, 1]`) of the radial edge points
@@ -405,16 +407,9 @@ fn radius_candidates(edges: &[EdgePoint], c: (f64, f64), r_max: f64) -> Vec<f64>
         .collect();
     let mut out = Vec::new();
     for _ in 0..2 {
-        let Some((k, &best)) = smooth
-            .iter()
-            .enumerate()
-            .max_by(|a, b| a.1.cmp(b.1).then(b.0.cmp(&a.0)))
-        else {
+        let Some(k) = strongest(&smooth) else {
             break;
         };
-        if best == 0 {
-            break;
-        }
         out.push(k as f64 + 0.5);
         for v in &mut smooth[k.saturating_sub(3)..(k + 4).min(bins)] {
             *v = 0;

@@ -51,13 +51,12 @@ fn to_linear<T: Copy + Sync>(
         .collect()
 }
 
-/// Decodes a PNG or JPEG file held in memory to linear RGB (row 0 at the top).
-pub fn decode(bytes: &[u8], limits: &Limits) -> Result<RawImage, DecodeError> {
-    let format = match ImageFormat::sniff(bytes) {
-        Some(ImageFormat::Png) => image::ImageFormat::Png,
-        Some(ImageFormat::Jpeg) => image::ImageFormat::Jpeg,
-        _ => return Err(wrong_magic("a PNG or JPEG file", bytes)),
-    };
+/// A reader of `bytes` in `format` that refuses images over `limits` before allocating.
+pub(crate) fn limited_reader<'a>(
+    bytes: &'a [u8],
+    format: image::ImageFormat,
+    limits: &Limits,
+) -> image::ImageReader<Cursor<&'a [u8]>> {
     let mut reader = image::ImageReader::with_format(Cursor::new(bytes), format);
     let mut il = image::Limits::default();
     il.max_image_width = Some(u32::try_from(limits.max_width).unwrap_or(u32::MAX));
@@ -69,6 +68,17 @@ pub fn decode(bytes: &[u8], limits: &Limits) -> Result<RawImage, DecodeError> {
             .saturating_add(1 << 20),
     );
     reader.limits(il);
+    reader
+}
+
+/// Decodes a PNG or JPEG file held in memory to linear RGB (row 0 at the top).
+pub fn decode(bytes: &[u8], limits: &Limits) -> Result<RawImage, DecodeError> {
+    let format = match ImageFormat::sniff(bytes) {
+        Some(ImageFormat::Png) => image::ImageFormat::Png,
+        Some(ImageFormat::Jpeg) => image::ImageFormat::Jpeg,
+        _ => return Err(wrong_magic("a PNG or JPEG file", bytes)),
+    };
+    let reader = limited_reader(bytes, format, limits);
     let decoder = reader.into_decoder().map_err(from_image_error)?;
     let (w, h) = decoder.dimensions();
     limits.check(u64::from(w), u64::from(h))?;

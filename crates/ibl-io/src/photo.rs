@@ -30,17 +30,7 @@ pub fn decode_codes(bytes: &[u8], limits: &Limits) -> Result<Image<[u8; 3]>, Dec
         Some(ImageFormat::Jpeg) => image::ImageFormat::Jpeg,
         _ => return Err(wrong_magic("a PNG or JPEG photograph", bytes)),
     };
-    let mut reader = image::ImageReader::with_format(std::io::Cursor::new(bytes), format);
-    let mut il = image::Limits::default();
-    il.max_image_width = Some(u32::try_from(limits.max_width).unwrap_or(u32::MAX));
-    il.max_image_height = Some(u32::try_from(limits.max_height).unwrap_or(u32::MAX));
-    il.max_alloc = Some(
-        (limits.max_pixels as u64)
-            .saturating_mul(8)
-            .saturating_add(1 << 20),
-    );
-    reader.limits(il);
-    let decoded = reader
+    let decoded = crate::ldr::limited_reader(bytes, format, limits)
         .decode()
         .map_err(|e| DecodeError::invalid(e.to_string().trim()))?;
     let rgb = decoded.to_rgb8();
