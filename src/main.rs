@@ -28,7 +28,9 @@ Examples:
   ibl preview probe.exr probe.png --tonemap aces
   ibl lights probe.exr -n 16 -o lights.json
   ibl eval assets/probes/*.exr --out eval     compare every extraction method (report.md)
+  ibl render assets/scenes/bunny-sky.toml -o bunny.exr   the bunny composited into a probe
   ibl compare render.exr reference.exr       RMSE, relative MSE and FLIP of a render
+  ibl capture merge IMG_*.jpg -o probe.exr   bracketed exposures to HDR
 
 Exit codes: 0 success, 1 internal failure, 2 bad input or arguments.";
 
