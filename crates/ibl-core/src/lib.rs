@@ -1,7 +1,8 @@
 //! Core types shared by every iblkit crate: linear RGB radiance, images with row 0 at the top,
 //! unit directions in the world frame (+Y up, -Z forward, +X right: the glTF frame), named frame
 //! presets, the lat-long parameterisation with exact texel solid angles, Fibonacci normals,
-//! summed-area tables and the exact irradiance of a lat-long probe.
+//! summed-area tables, the exact irradiance of a lat-long probe and a synthetic sky for
+//! benchmarks and tests.
 //!
 //! This crate does no I/O and knows no file formats; see `docs/CONVENTIONS.md` for every formula.
 
@@ -14,6 +15,7 @@ pub mod latlong;
 pub mod metrics;
 pub mod rgb;
 pub mod summed_area;
+pub mod synthetic;
 
 pub use direction::UnitDir;
 pub use fibonacci::fibonacci_normals;
@@ -25,3 +27,4 @@ pub use latlong::LatLong;
 pub use metrics::IrradianceError;
 pub use rgb::Rgb;
 pub use summed_area::SummedAreaTable;
+pub use synthetic::SyntheticSky;

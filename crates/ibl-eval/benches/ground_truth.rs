@@ -9,32 +9,11 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use ibl_core::glam::DVec3;
-use ibl_core::{Image, LatLong, Rgb, fibonacci_normals};
+use ibl_core::{SyntheticSky, fibonacci_normals};
 use ibl_eval::{FAST_DEFAULT_SIZE, irradiance_brute_force, irradiance_exact, irradiance_fast};
 
-fn environment(w: usize, h: usize) -> Image<Rgb> {
-    let ll = LatLong::new(w, h);
-    let sun = DVec3::new(0.3, 0.5, -0.8).normalize();
-    let cos_sun = 2.0f64.to_radians().cos();
-    Image::from_fn_par(w, h, |i, j| {
-        let d = ll.pixel_dir64(i, j);
-        let sky = if d.y > 0.0 {
-            Rgb::new(0.4 + 0.3 * d.y as f32, 0.6 + 0.2 * d.y as f32, 1.0)
-        } else {
-            let checker = ((i / 8 + j / 8) % 2) as f32;
-            Rgb::new(0.2 + 0.1 * checker, 0.15 + 0.1 * checker, 0.1)
-        };
-        if d.dot(sun) >= cos_sun {
-            sky + Rgb::splat(1000.0)
-        } else {
-            sky
-        }
-    })
-}
-
 fn bench(c: &mut Criterion) {
-    let probe = environment(512, 256);
+    let probe = SyntheticSky::default().render(512, 256);
     let normals = fibonacci_normals(20_000);
     let mut g = c.benchmark_group("ground_truth");
     g.sample_size(10);

@@ -8,28 +8,17 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use ibl_core::glam::{DVec3, Mat3};
-use ibl_core::{Image, LatLong, Rgb};
+use ibl_core::glam::Mat3;
+use ibl_core::{Image, Rgb, SyntheticSky};
 use ibl_mapping::{CubeLayout, Mapping, power, resample};
 
 fn environment(w: usize, h: usize) -> Image<Rgb> {
-    let ll = LatLong::new(w, h);
-    let sun = DVec3::new(0.3, 0.5, -0.8).normalize();
-    let cos_sun = 0.5f64.to_radians().cos();
-    Image::from_fn_par(w, h, |i, j| {
-        let d = ll.pixel_dir64(i, j);
-        let sky = if d.y > 0.0 {
-            Rgb::new(0.4 + 0.3 * d.y as f32, 0.6 + 0.2 * d.y as f32, 1.0)
-        } else {
-            let checker = ((i / 8 + j / 8) % 2) as f32;
-            Rgb::new(0.2 + 0.1 * checker, 0.15 + 0.1 * checker, 0.1)
-        };
-        if d.dot(sun) >= cos_sun {
-            sky + Rgb::splat(50_000.0)
-        } else {
-            sky
-        }
-    })
+    SyntheticSky {
+        sun_radius_deg: 0.5,
+        sun_radiance: 50_000.0,
+        ..SyntheticSky::default()
+    }
+    .render(w, h)
 }
 
 fn bench(c: &mut Criterion) {
