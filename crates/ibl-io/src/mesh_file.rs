@@ -498,6 +498,23 @@ impl Elements<'_> {
     }
 }
 
+/// An accessor whose type and component type have been checked, with what reading it needs.
+#[derive(Clone, Copy)]
+struct TypedAccessor<'r> {
+    accessor: &'r json::Accessor,
+    /// Its index in `root.accessors` (for messages).
+    index: usize,
+    /// Bytes of one element (components x component size).
+    element_size: u64,
+}
+
+impl TypedAccessor<'_> {
+    /// Number of elements, as the file states it (not yet checked against its buffer).
+    fn count(&self) -> u64 {
+        self.accessor.count.0
+    }
+}
+
 /// The accessor `index`, checked to have the given type and one of the component types.
 fn typed_accessor<'r>(
     root: &'r json::Root,
@@ -505,7 +522,7 @@ fn typed_accessor<'r>(
     what: &str,
     ty: Type,
     components: &[ComponentType],
-) -> Result<&'r json::Accessor, DecodeError> {
+) -> Result<TypedAccessor<'r>, DecodeError> {
     let Some(accessor) = root.accessors.get(index) else {
         return Err(DecodeError::invalid(format!(
             "{what}: accessor {index} does not exist ({} accessors)",
@@ -535,7 +552,11 @@ fn typed_accessor<'r>(
                 .join(" or ")
         )));
     }
-    Ok(accessor)
+    Ok(TypedAccessor {
+        accessor,
+        index,
+        element_size: type_components(ty) * component_size(actual_component.0),
+    })
 }
 
 fn component_size(c: ComponentType) -> u64 {
@@ -557,14 +578,18 @@ fn type_components(t: Type) -> u64 {
     }
 }
 
-/// Locates a (type-checked) accessor's bytes, checking every offset and length.
+/// Locates a type-checked accessor's bytes, checking every offset and length.
 fn elements<'b>(
     root: &json::Root,
     buffers: &'b mut Buffers<'_>,
-    index: usize,
-    accessor: &json::Accessor,
+    typed: TypedAccessor<'_>,
     what: &str,
 ) -> Result<Elements<'b>, DecodeError> {
+    let TypedAccessor {
+        accessor,
+        index,
+        element_size: size,
+    } = typed;
     if accessor.sparse.is_some() {
         return Err(DecodeError::Unsupported(format!(
             "{what}: accessor {index} is sparse"
@@ -584,14 +609,6 @@ fn elements<'b>(
             root.buffer_views.len()
         )));
     };
-    let (Checked::Valid(ty), Checked::Valid(component)) =
-        (&accessor.type_, &accessor.component_type)
-    else {
-        return Err(DecodeError::invalid(format!(
-            "{what}: accessor {index} has an unknown type"
-        )));
-    };
-    let size = type_components(*ty) * component_size(component.0);
     let stride = view.byte_stride.map_or(size, |s| s.0 as u64);
     if stride < size {
         return Err(DecodeError::invalid(format!(
@@ -750,16 +767,19 @@ impl<'l> GltfBuilder<'l> {
         let position_what = format!("{what} POSITION");
         let positions =
             typed_accessor(root, position_index, &position_what, Type::Vec3, &f32_only)?;
-        let vertex_count = positions.count.0;
+        let vertex_count = positions.count();
         let index_what = format!("{what} indices");
         let indices = match primitive.indices.map(|i| i.value()) {
-            Some(i) => Some((
+            Some(i) => Some(typed_accessor(
+                root,
                 i,
-                typed_accessor(root, i, &index_what, Type::Scalar, &index_types)?,
-            )),
+                &index_what,
+                Type::Scalar,
+                &index_types,
+            )?),
             None => None,
         };
-        let corner_count = indices.map_or(vertex_count, |(_, a)| a.count.0);
+        let corner_count = indices.map_or(vertex_count, |a| a.count());
         let triangle_count = match mode {
             Mode::Triangles if corner_count % 3 != 0 => {
                 return Err(DecodeError::invalid(format!(
@@ -794,37 +814,25 @@ impl<'l> GltfBuilder<'l> {
             return Ok(());
         }
 
-        let local_positions = read_vec3(&elements(
-            root,
-            buffers,
-            position_index,
-            positions,
-            &position_what,
-        )?);
+        let local_positions = read_vec3(&elements(root, buffers, positions, &position_what)?);
         let local_normals = match attribute(Semantic::Normals) {
             Some(normal_index) => {
                 let normal_what = format!("{what} NORMAL");
                 let normals =
                     typed_accessor(root, normal_index, &normal_what, Type::Vec3, &f32_only)?;
-                if normals.count.0 != vertex_count {
+                if normals.count() != vertex_count {
                     return Err(DecodeError::invalid(format!(
                         "{what}: {} normals for {vertex_count} positions",
-                        normals.count.0
+                        normals.count()
                     )));
                 }
-                Some(read_vec3(&elements(
-                    root,
-                    buffers,
-                    normal_index,
-                    normals,
-                    &normal_what,
-                )?))
+                Some(read_vec3(&elements(root, buffers, normals, &normal_what)?))
             }
             None => None,
         };
         let corners: Vec<u32> = match indices {
-            Some((i, accessor)) => {
-                let corners = read_indices(&elements(root, buffers, i, accessor, &index_what)?);
+            Some(accessor) => {
+                let corners = read_indices(&elements(root, buffers, accessor, &index_what)?);
                 if let Some(bad) = corners.iter().find(|&&c| u64::from(c) >= vertex_count) {
                     return Err(DecodeError::invalid(format!(
                         "{what}: index {bad} out of range ({vertex_count} vertices)"
