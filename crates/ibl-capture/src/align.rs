@@ -41,6 +41,7 @@ use ibl_core::Image;
 use rayon::prelude::*;
 
 use crate::CaptureError;
+use crate::response::check_same_size;
 
 /// Codes within this distance of the split code are excluded from the comparison (Ward's noise
 /// tolerance, in 8-bit grey codes).
@@ -89,7 +90,7 @@ pub fn align_to(
     image: &Image<[u8; 3]>,
     options: &AlignOptions,
 ) -> Result<Shift, CaptureError> {
-    check_same_size(&[reference, image])?;
+    check_same_size([reference, image])?;
     let levels = pyramid_levels(reference.width(), reference.height(), options.max_levels);
     let reference = Pyramid::new(reference, levels);
     let image = Pyramid::new(image, levels);
@@ -108,7 +109,7 @@ pub fn align_bracket(
     if images.is_empty() {
         return Err(CaptureError::Invalid("no images to align".into()));
     }
-    check_same_size(&images.iter().collect::<Vec<_>>())?;
+    check_same_size(images)?;
     let reference_index = images.len() / 2;
     let levels = pyramid_levels(images[0].width(), images[0].height(), options.max_levels);
     let reference = Pyramid::new(&images[reference_index], levels);
@@ -153,31 +154,6 @@ pub fn apply_shift<T: Copy + Send + Sync>(
     });
     let valid = Image::from_fn_par(w, h, |x, y| source(x, y).2);
     (aligned, valid)
-}
-
-fn check_same_size(images: &[&Image<[u8; 3]>]) -> Result<(), CaptureError> {
-    let Some(first) = images.first() else {
-        return Ok(());
-    };
-    if first.is_empty() {
-        return Err(CaptureError::Invalid(format!(
-            "cannot align an empty image ({} x {})",
-            first.width(),
-            first.height()
-        )));
-    }
-    for (i, image) in images.iter().enumerate().skip(1) {
-        if image.width() != first.width() || image.height() != first.height() {
-            return Err(CaptureError::Invalid(format!(
-                "image {i} is {} x {} but image 0 is {} x {}: a bracket must share one size",
-                image.width(),
-                image.height(),
-                first.width(),
-                first.height()
-            )));
-        }
-    }
-    Ok(())
 }
 
 /// Number of halvings for a `w x h` image: while the next level keeps [`MIN_COARSE_SIDE`] pixels

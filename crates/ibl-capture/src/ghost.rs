@@ -46,6 +46,7 @@ use ibl_core::Image;
 use rayon::prelude::*;
 
 use crate::CaptureError;
+use crate::response::check_bracket;
 
 /// Codes that count as well exposed when choosing the reference (all three channels must lie in
 /// this range: 10 % to 90 % of the code range).
@@ -119,8 +120,8 @@ impl GhostOptions {
 /// camera's linear relative exposure for an 8-bit code of channel 0 (R), 1 (G) or 2 (B) (the
 /// inverted response curve, e.g. `exp(g(z))` of Debevec & Malik). It is tabulated once.
 ///
-/// Errors: [`CaptureError::Invalid`] if there are no images, sizes differ, the number of times
-/// differs from the number of images or a time is not finite and positive;
+/// Errors: [`CaptureError::Invalid`] if there are no images, they are empty or differ in size, the
+/// number of times differs from the number of images or a time is not finite and positive;
 /// [`CaptureError::Parameter`] if the options are out of range or `exposure_of` gives a value
 /// that is not finite, negative, or not positive above `dark_code`.
 pub fn ghost_weights(
@@ -197,42 +198,6 @@ pub fn reference_exposure(images: &[Image<[u8; 3]>]) -> Result<usize, CaptureErr
         }
     }
     Ok(best)
-}
-
-fn check_bracket(images: &[Image<[u8; 3]>], times_s: &[f32]) -> Result<(), CaptureError> {
-    let Some(first) = images.first() else {
-        return Err(CaptureError::Invalid(
-            "ghost test: no exposures given".into(),
-        ));
-    };
-    if times_s.len() != images.len() {
-        return Err(CaptureError::Invalid(format!(
-            "ghost test: {} exposure times for {} images",
-            times_s.len(),
-            images.len()
-        )));
-    }
-    for (i, image) in images.iter().enumerate() {
-        if image.width() != first.width() || image.height() != first.height() {
-            return Err(CaptureError::Invalid(format!(
-                "ghost test: image {i} is {} x {} but image 0 is {} x {}",
-                image.width(),
-                image.height(),
-                first.width(),
-                first.height()
-            )));
-        }
-    }
-    if let Some((i, t)) = times_s
-        .iter()
-        .enumerate()
-        .find(|(_, t)| !(t.is_finite() && **t > 0.0))
-    {
-        return Err(CaptureError::Invalid(format!(
-            "ghost test: exposure time {i} is {t} s (must be finite and positive)"
-        )));
-    }
-    Ok(())
 }
 
 /// What one channel code says about `ln L`: `lo <= ln L <= hi` (equal when the code is valid),

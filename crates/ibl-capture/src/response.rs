@@ -326,38 +326,50 @@ impl ResponseCurve {
 /// image the same non-zero size. Returns (width, height).
 pub(crate) fn check_bracket<T>(
     images: &[Image<T>],
-    exposure_times_s: &[f64],
+    exposure_times_s: &[impl Copy + Into<f64>],
 ) -> Result<(usize, usize), CaptureError> {
-    let Some(first) = images.first() else {
-        return Err(CaptureError::Invalid("no exposures given".into()));
-    };
-    if exposure_times_s.len() != images.len() {
+    if !images.is_empty() && exposure_times_s.len() != images.len() {
         return Err(CaptureError::Invalid(format!(
             "{} exposures but {} exposure times: every exposure needs its time",
             images.len(),
             exposure_times_s.len()
         )));
     }
+    let size = check_same_size(images)?;
+    for (k, &t) in exposure_times_s.iter().enumerate() {
+        let t: f64 = t.into();
+        if !(t.is_finite() && t > 0.0) {
+            return Err(CaptureError::Invalid(format!(
+                "exposure time {k} is {t} s: exposure times must be finite and positive"
+            )));
+        }
+    }
+    Ok(size)
+}
+
+/// Checks that there is at least one image and that all have the same non-zero size. Returns
+/// (width, height).
+pub(crate) fn check_same_size<'a, T: 'a>(
+    images: impl IntoIterator<Item = &'a Image<T>>,
+) -> Result<(usize, usize), CaptureError> {
+    let mut images = images.into_iter();
+    let Some(first) = images.next() else {
+        return Err(CaptureError::Invalid("no exposures given".into()));
+    };
     let (width, height) = (first.width(), first.height());
     if first.is_empty() {
         return Err(CaptureError::Invalid(format!(
             "the exposures are empty ({width} x {height} pixels)"
         )));
     }
-    for (k, image) in images.iter().enumerate() {
+    for (k, image) in images.enumerate() {
         if image.width() != width || image.height() != height {
             return Err(CaptureError::Invalid(format!(
-                "exposure {k} is {} x {} pixels but exposure 0 is {width} x {height}: every \
+                "exposure {} is {} x {} pixels but exposure 0 is {width} x {height}: every \
                  exposure of a bracket must have the same size",
+                k + 1,
                 image.width(),
                 image.height()
-            )));
-        }
-    }
-    for (k, &t) in exposure_times_s.iter().enumerate() {
-        if !(t.is_finite() && t > 0.0) {
-            return Err(CaptureError::Invalid(format!(
-                "exposure time {k} is {t} s: exposure times must be finite and positive"
             )));
         }
     }
