@@ -167,15 +167,18 @@ material = {material}
     scene(&toml, constant_probe(radiance))
 }
 
+/// Each pixel of the render with objects, with its object coverage (0 to 1).
+fn pixels_and_coverage(out: &RenderOutput) -> impl Iterator<Item = (&Rgb, f32)> {
+    out.with_objects
+        .pixels()
+        .iter()
+        .zip(out.object_coverage.pixels().iter().copied())
+}
+
 /// Per channel, the pixel means of the fully covered sphere pixels (with objects).
 fn sphere_pixel_values(out: &RenderOutput) -> [Vec<f64>; 3] {
     let mut values: [Vec<f64>; 3] = Default::default();
-    for (p, &c) in out
-        .with_objects
-        .pixels()
-        .iter()
-        .zip(out.object_coverage.pixels())
-    {
+    for (p, c) in pixels_and_coverage(out) {
         if c == 1.0 {
             for (k, v) in values.iter_mut().enumerate() {
                 v.push(f64::from(p[k]));
@@ -216,12 +219,7 @@ fn white_furnace_sphere_is_the_environment() {
             l[k]
         );
     }
-    for (p, &c) in out
-        .with_objects
-        .pixels()
-        .iter()
-        .zip(out.object_coverage.pixels())
-    {
+    for (p, c) in pixels_and_coverage(&out) {
         if c == 0.0 {
             assert_eq!(*p, l);
         }
@@ -907,12 +905,7 @@ fn a_mirror_sphere_reflects_the_environment_in_every_mode() {
             &settings(4, 4, 3, CompositeRule::Difference),
         );
         let mut covered = 0;
-        for (p, &c) in out
-            .with_objects
-            .pixels()
-            .iter()
-            .zip(out.object_coverage.pixels())
-        {
+        for (p, c) in pixels_and_coverage(&out) {
             if c == 1.0 {
                 covered += 1;
                 for k in 0..3 {
