@@ -7,7 +7,7 @@
 
 use std::sync::LazyLock;
 
-use ibl_core::{Image, Rgb};
+use crate::{Image, Rgb};
 use rayon::prelude::*;
 
 /// How exposed linear values above 1 are brought into the displayable range `[0, 1]`.

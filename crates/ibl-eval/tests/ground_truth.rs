@@ -16,9 +16,9 @@ use std::time::Instant;
 use ibl_core::glam::DVec3;
 use ibl_core::{Image, LatLong, Rgb, fibonacci_normals};
 use ibl_eval::{
-    FAST_DEFAULT_SIZE, GroundTruth, IrradianceError, irradiance_brute_force, irradiance_exact,
-    irradiance_fast, max_err_pct, mean_err_pct, rel_max_err_pct, rel_mean_err_pct,
+    FAST_DEFAULT_SIZE, GroundTruth, irradiance_brute_force, irradiance_exact, irradiance_fast,
 };
+use ibl_metrics::{IrradianceError, max_err_pct, mean_err_pct, rel_max_err_pct, rel_mean_err_pct};
 
 fn rel(a: f64, b: f64) -> f64 {
     (a - b).abs() / b.abs().max(1e-300)

@@ -91,7 +91,7 @@ fn lights_partition_the_probe_and_conserve_power_on_every_bundled_probe() {
                 "{name} K={k}: {sr}"
             );
             for l in &set.lights {
-                let d = l.dir();
+                let d = l.direction;
                 assert!((d.length() - 1.0).abs() < 1e-12);
                 for c in 0..3 {
                     let i = f64::from(l.radiance.to_array()[c]) * l.solid_angle_sr;
@@ -143,7 +143,7 @@ fn constant_environment_first_cut_is_down_the_middle() {
     assert_eq!((r[0].x1, r[1].x0), (32, 32));
     // Each half is a hemisphere (left: -X, right: +X) with power 2 * 2 pi.
     for (l, sign) in set.lights.iter().zip([-1.0, 1.0]) {
-        assert!((l.dir().x - sign).abs() < 1e-9, "{:?}", l.direction);
+        assert!((l.direction.x - sign).abs() < 1e-9, "{:?}", l.direction);
         for c in 0..3 {
             assert!((l.irradiance[c] - 4.0 * std::f64::consts::PI).abs() < 1e-9);
         }
@@ -169,7 +169,7 @@ fn a_single_bright_pixel_becomes_one_light_in_its_direction() {
         })
         .unwrap();
     assert!(
-        owner.dir().dot(d) > 0.99999,
+        owner.direction.dot(d) > 0.99999,
         "{:?} vs {d:?}",
         owner.direction
     );

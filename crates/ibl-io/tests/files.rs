@@ -7,11 +7,11 @@ mod common;
 use std::path::Path;
 
 use common::{bits, hdr_test_image, max_rel_error};
+use ibl_core::tonemap::{Display, ToneCurve, srgb_to_linear};
 use ibl_core::{Image, Rgb};
-use ibl_io::tonemap::srgb_to_linear;
 use ibl_io::{
-    Display, ExrOptions, ExrPrecision, ImageFormat, IoError, ToneCurve, WriteOptions,
-    ensure_output_is_not_input, read_image, write_image,
+    ExrOptions, ExrPrecision, ImageFormat, IoError, WriteOptions, ensure_output_is_not_input,
+    read_image, write_image,
 };
 
 fn leftovers(dir: &Path) -> Vec<String> {

@@ -161,7 +161,7 @@ fn mutated_files_never_panic() {
             Rgb::new(x as f32 * 0.3, y as f32, 1.0 / (1 + x) as f32)
         }
     });
-    let srgb = ibl_io::tonemap::to_srgb8(&img, &ibl_io::Display::default());
+    let srgb = ibl_core::tonemap::to_srgb8(&img, &ibl_core::tonemap::Display::default());
     let mut seeds: Vec<(&str, Vec<u8>)> = vec![
         ("hdr rle", hdr::encode(&img)),
         ("hdr flat", hdr::encode_flat(&img)),

@@ -3,9 +3,9 @@
 
 use std::path::PathBuf;
 
+use ibl_core::tonemap::{Display, ToneCurve, auto_exposure_stops, to_srgb8};
 use ibl_core::{Image, Rgb};
-use ibl_io::tonemap::{auto_exposure_stops, to_srgb8};
-use ibl_io::{Display, ToneCurve, read_image};
+use ibl_io::read_image;
 
 fn one(v: f32, display: Display) -> [u8; 3] {
     *to_srgb8(&Image::filled(1, 1, Rgb::splat(v)), &display).get(0, 0)

@@ -79,6 +79,14 @@ pub enum MappingError {
     Parameter(String),
 }
 
+impl MappingError {
+    /// Always true: a shape that does not fit its mapping, or a parameter out of range, is the
+    /// caller's input.
+    pub fn is_bad_input(&self) -> bool {
+        true
+    }
+}
+
 /// The canonical names of every mapping, for help texts.
 pub const MAPPING_NAMES: [&str; 8] = [
     "latlong",

@@ -60,7 +60,7 @@
 use ibl_core::{Image, Rgb};
 use rayon::prelude::*;
 
-use crate::image_difference::{DifferenceError, check_sizes};
+use crate::comparison::{DifferenceError, check_sizes};
 
 /// Default viewing condition, pixels per degree of visual angle: a 0.7 m wide 3840-pixel
 /// monitor seen from 0.7 m (`0.7 * 3840 / 0.7 * pi / 180 = 67.0`).
@@ -187,7 +187,11 @@ pub fn flip(
     check_sizes(test, reference)?;
     let ppd = options.pixels_per_degree;
     if !(MIN_PIXELS_PER_DEGREE..=MAX_PIXELS_PER_DEGREE).contains(&ppd) {
-        return Err(DifferenceError::PixelsPerDegree(ppd));
+        return Err(DifferenceError::PixelsPerDegree {
+            value: ppd,
+            min: MIN_PIXELS_PER_DEGREE,
+            max: MAX_PIXELS_PER_DEGREE,
+        });
     }
     let kernels = Kernels::new(ppd);
     let cmax = colour_cmax();
@@ -689,7 +693,7 @@ mod tests {
             };
             assert!(matches!(
                 flip(&a, &a, &options),
-                Err(DifferenceError::PixelsPerDegree(_))
+                Err(DifferenceError::PixelsPerDegree { .. })
             ));
         }
     }

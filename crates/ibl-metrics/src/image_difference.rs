@@ -18,118 +18,19 @@
 //!
 //! Per-pixel maps ([`relative_squared_error_map`], [`absolute_error_map`]) hold the mean over the
 //! three channels of the same per-channel terms, so their mean over the pixels is the scalar
-//! metric. [`false_colour`] draws any such map on the viridis scale; [`MapStatistics`] gives the
-//! mean and percentiles of a map (as for the FLIP map of [`mod@crate::flip`]).
+//! metric; [`MapStatistics`] gives the mean and percentiles of a map (as for the FLIP map of
+//! [`mod@crate::flip`]). Drawing a map in false colour is `ibl-eval`'s.
 //!
 //! Sums are f64, per row in column order, then over rows in row order (fixed partition): results
 //! are bit-identical whatever the rayon thread count. Cost O(W H); percentiles O(N log N).
 
-use std::fmt;
-
 use ibl_core::{Image, Rgb};
 use rayon::prelude::*;
 
-use crate::sphere_image::viridis;
+use crate::comparison::{DifferenceError, check_mask, check_sizes, selected};
 
 /// `eps` of the relative MSE, `(a - b)^2 / (b^2 + eps)`, in squared image units.
 pub const RELATIVE_MSE_EPSILON: f64 = 0.01;
-
-/// Why two images (or an image and its mask) cannot be compared.
-#[derive(Clone, Debug, PartialEq)]
-pub enum DifferenceError {
-    /// The test and reference images differ in size.
-    SizeMismatch {
-        /// Test image `[width, height]`.
-        test: [usize; 2],
-        /// Reference image `[width, height]`.
-        reference: [usize; 2],
-    },
-    /// The mask differs in size from the images.
-    MaskSizeMismatch {
-        /// Mask `[width, height]`.
-        mask: [usize; 2],
-        /// Images `[width, height]`.
-        image: [usize; 2],
-    },
-    /// Nothing to compare: an empty image, or a mask that selects no pixel.
-    NoPixels,
-    /// A viewing condition outside the supported range (FLIP's pixels per degree).
-    PixelsPerDegree(f64),
-}
-
-impl fmt::Display for DifferenceError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            DifferenceError::SizeMismatch { test, reference } => write!(
-                f,
-                "the test image is {} x {} but the reference is {} x {}",
-                test[0], test[1], reference[0], reference[1]
-            ),
-            DifferenceError::MaskSizeMismatch { mask, image } => write!(
-                f,
-                "the mask is {} x {} but the images are {} x {}",
-                mask[0], mask[1], image[0], image[1]
-            ),
-            DifferenceError::NoPixels => {
-                write!(f, "no pixels to compare (empty image or empty mask)")
-            }
-            DifferenceError::PixelsPerDegree(v) => write!(
-                f,
-                "pixels per degree must be between {} and {}, got {v}",
-                crate::flip::MIN_PIXELS_PER_DEGREE,
-                crate::flip::MAX_PIXELS_PER_DEGREE
-            ),
-        }
-    }
-}
-
-impl std::error::Error for DifferenceError {}
-
-/// `[width, height]` of an image.
-fn size_of<T>(image: &Image<T>) -> [usize; 2] {
-    [image.width(), image.height()]
-}
-
-/// Checks that `test` and `reference` have the same, non-zero size.
-pub(crate) fn check_sizes(
-    test: &Image<Rgb>,
-    reference: &Image<Rgb>,
-) -> Result<(), DifferenceError> {
-    if size_of(test) != size_of(reference) {
-        return Err(DifferenceError::SizeMismatch {
-            test: size_of(test),
-            reference: size_of(reference),
-        });
-    }
-    if reference.is_empty() {
-        return Err(DifferenceError::NoPixels);
-    }
-    Ok(())
-}
-
-/// Checks that a mask, if any, has the size of `image` and selects at least one pixel.
-fn check_mask<T>(image: &Image<T>, mask: Option<&Image<bool>>) -> Result<(), DifferenceError> {
-    if let Some(m) = mask {
-        if size_of(m) != size_of(image) {
-            return Err(DifferenceError::MaskSizeMismatch {
-                mask: size_of(m),
-                image: size_of(image),
-            });
-        }
-        if !m.pixels().iter().any(|&b| b) {
-            return Err(DifferenceError::NoPixels);
-        }
-    }
-    if image.is_empty() {
-        return Err(DifferenceError::NoPixels);
-    }
-    Ok(())
-}
-
-/// Whether pixel `i` (row-major index) is compared.
-fn selected(mask: Option<&Image<bool>>, i: usize) -> bool {
-    mask.is_none_or(|m| m.pixels()[i])
-}
 
 /// The scalar error metrics of a test image against a reference (see the module notes).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -249,28 +150,6 @@ pub fn absolute_error_map(
     reference: &Image<Rgb>,
 ) -> Result<Image<f32>, DifferenceError> {
     channel_mean_map(test, reference, |a, b| (a - b).abs())
-}
-
-/// Colour of the pixels outside the mask in [`false_colour`] (sRGB mid grey).
-pub const MASKED_OUT_COLOUR: [u8; 3] = [128, 128, 128];
-
-/// An error map on the viridis scale (8-bit sRGB): 0 is dark purple, `top` and above yellow;
-/// pixels outside `mask` are [`MASKED_OUT_COLOUR`]. A `top` that is not positive draws every
-/// pixel at the bottom colour. O(W H).
-pub fn false_colour(map: &Image<f32>, top: f64, mask: Option<&Image<bool>>) -> Image<[u8; 3]> {
-    let w = map.width();
-    let mask = mask.filter(|m| size_of(*m) == size_of(map));
-    Image::from_fn_par(w, map.height(), |x, y| {
-        if !selected(mask, y * w + x) {
-            return MASKED_OUT_COLOUR;
-        }
-        let t = if top > 0.0 {
-            f64::from(*map.get(x, y)) / top
-        } else {
-            0.0
-        };
-        viridis(t)
-    })
 }
 
 /// Mean, percentiles and maximum of a per-pixel error map over the selected pixels.
@@ -416,13 +295,6 @@ mod tests {
         assert_eq!(d.rmse, 0.0);
         let all = ImageDifference::between(&test, &reference, None).unwrap();
         assert!((all.mean_abs - 0.5).abs() < 1e-12 && (all.rmse - f64::sqrt(0.5)).abs() < 1e-12);
-        let colours = false_colour(
-            &absolute_error_map(&test, &reference).unwrap(),
-            1.0,
-            Some(&right),
-        );
-        assert_eq!(*colours.get(0, 0), MASKED_OUT_COLOUR);
-        assert_eq!(*colours.get(7, 1), viridis(0.0));
         let none = Image::filled(8, 2, false);
         assert_eq!(
             ImageDifference::between(&test, &reference, Some(&none)),

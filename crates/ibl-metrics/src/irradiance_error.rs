@@ -40,7 +40,7 @@ impl IrradianceError {
             approx.len(),
             "ground truth and approximation must cover the same normals"
         );
-        let mu = crate::channel_means(truth);
+        let mu = ibl_core::channel_means(truth);
         let n = truth.len();
         let (mut mean_sum, mut max_sum, mut rel_sum, mut rel_max) = (0.0, 0.0, 0.0, 0.0f64);
         let mut channels = 0usize;

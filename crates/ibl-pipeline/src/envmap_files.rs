@@ -1,4 +1,5 @@
-//! Environment maps on disk: one image file in any mapping, or a cube map as six face files.
+//! Environment maps on disk: one image file in any mapping, or a cube map as six face files (the
+//! cube file sets every front end reads and writes the same way).
 //!
 //! Six-file cube maps are named by a pattern containing `{face}` (replaced by `px nx py ny pz nz`
 //! for +X -X +Y -Y +Z -Z); a path without `{face}` gets `_px` etc. before its extension. Inside,
@@ -6,31 +7,31 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::Context;
 use ibl_core::{Image, Rgb};
 use ibl_io::{ImageFormat, LoadedImage, SanitizeReport, WriteOptions};
 use ibl_mapping::{CUBE_FACE_NAMES, CubeLayout, Mapping};
 
-use crate::failure::usage;
+use crate::error::{Context, PipelineError, Result};
+use crate::progress::Progress;
 
-/// A mapping named on the command line: one image in a mapping, or six cube-face files.
+/// How an environment map lies on disk: one image in a mapping, or six cube-face files.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub enum MappingArg {
+pub enum EnvMapping {
     /// A single image in this mapping.
     Single(Mapping),
     /// Six files, one per cube face.
     CubeFaces,
 }
 
-impl MappingArg {
+impl EnvMapping {
     /// Parses a mapping name (`cube-faces` or any name [`Mapping::parse`] knows); `fov_deg` is
     /// the field of view for the fisheye mappings.
-    pub fn parse(name: &str, fov_deg: f32) -> anyhow::Result<MappingArg> {
+    pub fn parse(name: &str, fov_deg: f32) -> Result<EnvMapping> {
         if matches!(name, "cube-faces" | "faces" | "cube-6") {
-            return Ok(MappingArg::CubeFaces);
+            return Ok(EnvMapping::CubeFaces);
         }
-        Mapping::parse(name, fov_deg).map(MappingArg::Single).ok_or_else(|| {
-            usage(format!(
+        Mapping::parse(name, fov_deg).map(EnvMapping::Single).ok_or_else(|| {
+            PipelineError::parameter(format!(
                 "unknown mapping `{name}` (expected latlong, angular, mirror-ball, cube-hcross, \
                  cube-vcross, cube-strip, cube-faces, fisheye or dual-fisheye)"
             ))
@@ -40,17 +41,45 @@ impl MappingArg {
     /// The mapping of the in-memory image.
     pub fn in_memory(self) -> Mapping {
         match self {
-            MappingArg::Single(m) => m,
-            MappingArg::CubeFaces => Mapping::Cube(CubeLayout::HorizontalStrip),
+            EnvMapping::Single(m) => m,
+            EnvMapping::CubeFaces => Mapping::Cube(CubeLayout::HorizontalStrip),
         }
     }
 
     /// Name for messages and reports.
     pub fn name(self) -> String {
         match self {
-            MappingArg::Single(m) => m.name(),
-            MappingArg::CubeFaces => "cube-faces".to_string(),
+            EnvMapping::Single(m) => m.name(),
+            EnvMapping::CubeFaces => "cube-faces".to_string(),
         }
+    }
+}
+
+/// Checks before any work that `path` names an image format iblkit writes and no input.
+pub fn check_output(path: &Path, inputs: &[&Path]) -> Result<()> {
+    if ImageFormat::from_path(path).is_none() {
+        return Err(PipelineError::parameter(format!(
+            "{}: unknown output format (use .exr, .hdr, .pfm, .png or .jpg)",
+            path.display()
+        )));
+    }
+    ibl_io::ensure_output_is_not_input(path, inputs)?;
+    Ok(())
+}
+
+/// Tells the user, through `progress`, how many invalid values reading clamped, if any.
+pub fn note_clamped(env: &LoadedEnv, progress: &dyn Progress) {
+    let r = &env.report;
+    if r.negative_values + r.nonfinite_values > 0 {
+        progress.note(&format!(
+            "note: {}: clamped {} negative and {} NaN/Inf values to 0",
+            env.files
+                .first()
+                .map(|p| p.display().to_string())
+                .unwrap_or_default(),
+            r.negative_values,
+            r.nonfinite_values
+        ));
     }
 }
 
@@ -94,8 +123,8 @@ pub fn face_paths(pattern: &Path) -> Vec<PathBuf> {
 }
 
 /// Reads an environment map; the mapping is `mapping` or, when `None`, guessed from the shape.
-pub fn load(path: &Path, mapping: Option<MappingArg>) -> anyhow::Result<LoadedEnv> {
-    if mapping == Some(MappingArg::CubeFaces) {
+pub fn load(path: &Path, mapping: Option<EnvMapping>) -> Result<LoadedEnv> {
+    if mapping == Some(EnvMapping::CubeFaces) {
         return load_faces(path);
     }
     let LoadedImage {
@@ -110,7 +139,11 @@ pub fn load(path: &Path, mapping: Option<MappingArg>) -> anyhow::Result<LoadedEn
     };
     mapping
         .check_shape(image.width(), image.height())
-        .with_context(|| format!("{}: not a {} image", path.display(), mapping.name()))?;
+        .context(format!(
+            "{}: not a {} image",
+            path.display(),
+            mapping.name()
+        ))?;
     Ok(LoadedEnv {
         image,
         mapping,
@@ -121,7 +154,7 @@ pub fn load(path: &Path, mapping: Option<MappingArg>) -> anyhow::Result<LoadedEn
     })
 }
 
-fn load_faces(pattern: &Path) -> anyhow::Result<LoadedEnv> {
+fn load_faces(pattern: &Path) -> Result<LoadedEnv> {
     let paths = face_paths(pattern);
     let mut faces = Vec::with_capacity(6);
     let mut report: Option<SanitizeReport> = None;
@@ -132,13 +165,18 @@ fn load_faces(pattern: &Path) -> anyhow::Result<LoadedEnv> {
         first.get_or_insert((loaded.format, loaded.details));
         faces.push(loaded.image);
     }
-    let report = report.ok_or_else(|| anyhow::anyhow!("no cube face read"))?;
-    let faces: [Image<Rgb>; 6] = faces
-        .try_into()
-        .map_err(|_| anyhow::anyhow!("expected six cube faces"))?;
-    let image = ibl_mapping::join_cube_faces(&faces, CubeLayout::HorizontalStrip)
-        .with_context(|| format!("{}: cube faces do not fit together", pattern.display()))?;
-    let (format, details) = first.ok_or_else(|| anyhow::anyhow!("no cube face read"))?;
+    // `face_paths` always names six files, so six were read.
+    let (Some(report), Some((format, details)), Ok(faces)) =
+        (report, first, <[Image<Rgb>; 6]>::try_from(faces))
+    else {
+        return Err(PipelineError::parameter(format!(
+            "{}: expected six cube faces",
+            pattern.display()
+        )));
+    };
+    let image = ibl_mapping::join_cube_faces(&faces, CubeLayout::HorizontalStrip).context(
+        format!("{}: cube faces do not fit together", pattern.display()),
+    )?;
     Ok(LoadedEnv {
         image,
         mapping: Mapping::Cube(CubeLayout::HorizontalStrip),
@@ -149,30 +187,24 @@ fn load_faces(pattern: &Path) -> anyhow::Result<LoadedEnv> {
     })
 }
 
-/// Writes an environment map (six files for [`MappingArg::CubeFaces`]), refusing to overwrite
+/// Writes an environment map (six files for [`EnvMapping::CubeFaces`]), refusing to overwrite
 /// any of `inputs`. Returns the files written.
 pub fn save(
     path: &Path,
     image: &Image<Rgb>,
-    mapping: MappingArg,
+    mapping: EnvMapping,
     options: &WriteOptions,
     inputs: &[&Path],
-) -> anyhow::Result<Vec<PathBuf>> {
+) -> Result<Vec<PathBuf>> {
     let targets: Vec<(PathBuf, Image<Rgb>)> = match mapping {
-        MappingArg::Single(_) => vec![(path.to_path_buf(), image.clone())],
-        MappingArg::CubeFaces => {
+        EnvMapping::Single(_) => vec![(path.to_path_buf(), image.clone())],
+        EnvMapping::CubeFaces => {
             let faces = ibl_mapping::split_cube_faces(image, CubeLayout::HorizontalStrip)?;
             face_paths(path).into_iter().zip(faces).collect()
         }
     };
     for (p, _) in &targets {
-        if ImageFormat::from_path(p).is_none() {
-            return Err(usage(format!(
-                "{}: unknown output format (use .exr, .hdr, .pfm, .png or .jpg)",
-                p.display()
-            )));
-        }
-        ibl_io::ensure_output_is_not_input(p, inputs)?;
+        check_output(p, inputs)?;
     }
     for (p, img) in &targets {
         ibl_io::write_image(p, img, options)?;

@@ -110,7 +110,7 @@ fn defaults_fill_what_is_left_out() {
     assert_eq!(d.render.width, None);
     assert_eq!(d.render.composite, CompositeRule::Difference);
     let l = &d.lighting;
-    assert_eq!((l.method.as_str(), l.lights), ("median-cut", 16));
+    assert_eq!((l.method.name(), l.lights), ("median-cut", 16));
     assert_eq!((l.ambient_bands, l.ao_samples), (3, 16));
     assert!(l.lights_file.is_none());
 }

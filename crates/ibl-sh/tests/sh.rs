@@ -8,7 +8,8 @@ use std::f64::consts::PI;
 use std::path::Path;
 
 use ibl_core::glam::{DMat3, DVec3};
-use ibl_core::{Image, IrradianceError, LatLong, Rgb, fibonacci_normals, irradiance_exact};
+use ibl_core::{Image, LatLong, Rgb, fibonacci_normals, irradiance_exact};
+use ibl_metrics::IrradianceError;
 use ibl_sh::{RadianceSh, Window, basis, lambert_factor, project_latlong, sh_index};
 
 /// A 512 x 256 lat-long probe with radiance `f(d)` at every pixel centre.

@@ -1,9 +1,4 @@
-//! Triangle meshes from files: glTF 2.0 (`.gltf`, `.glb`) and Wavefront OBJ (`.obj` with its
-//! `.mtl`), read into an [`ibl_scene::TriangleMesh`] in the model's own frame (no placement; glTF
-//! models are +Y up with metres as units, OBJ units are whatever the file used) plus one linear
-//! base colour per material group.
-//!
-//! **glTF 2.0** (Khronos glTF 2.0 specification: GLB container, buffers, accessors, meshes, node
+//! glTF 2.0 meshes (Khronos glTF 2.0 specification: GLB container, buffers, accessors, meshes, node
 //! hierarchy). The GLB container (12-byte header, a JSON chunk, an optional BIN chunk) is split
 //! here; the JSON is deserialised with `gltf-json` but *not* run through its validation pass (that
 //! pass indexes arrays without bounds checks on hostile files); every index, offset, stride and
@@ -23,25 +18,7 @@
 //! read. Base colours are `baseColorFactor.rgb` (linear; the specification's default is 1), and
 //! 0.8 grey ([`DEFAULT_BASE_COLOR`]) for primitives without a material.
 //!
-//! **OBJ** (Wavefront "Object Files (.obj)" appendix B1 of the Advanced Visualizer manual): read by
-//! a line parser of our own rather than `tobj`, because `tobj` 4.0.5 panics on an overflowing
-//! multiplication for a face such as `f 1//-9223372036854775807` (with overflow checks on) and
-//! forgets `usemtl` names when the `.mtl` is missing. Lines `v`, `vn`, `f`, `usemtl` and
-//! `mtllib` are read, everything else (`vt`, `o`, `g`, `s`, `l`, `p`, curves) is ignored. Face
-//! corners `v`, `v/vt`, `v//vn`, `v/vt/vn` take 1-based or negative (relative) indices that must
-//! refer to data defined earlier in the file; polygons are fan-triangulated
-//! `(c0, c[i], c[i+1])`, which is exact for convex polygons. Each distinct (position, normal) pair
-//! becomes one vertex. Each `usemtl` name is a material group (faces before the first `usemtl`
-//! form `"default"`); its base colour is the `Kd` of the `.mtl` files named by `mtllib` and found
-//! next to the `.obj`; a missing `.mtl` only leaves 0.8 grey.
-//!
-//! Normals are kept only when every triangle's corners have one (and none is zero-length);
-//! otherwise the mesh gets none and is shaded flat, with a note in [`LoadedMesh::details`]. No
-//! normals are ever computed. Finally [`TriangleMesh::validate`] refuses out-of-range indices and
-//! non-finite data and drops zero-area triangles.
-//!
-//! Cost: one pass over the file, O(bytes + vertices + triangles) time (plus a hash map lookup per
-//! OBJ face corner); memory is the file's bytes plus the output mesh.
+//! Normals, validation and the details line: see [`super`].
 
 use std::borrow::Cow;
 use std::collections::HashMap;
@@ -55,107 +32,13 @@ use ibl_core::Rgb;
 use ibl_core::glam::{Mat3, Mat4, Quat, Vec3};
 use ibl_scene::TriangleMesh;
 
-use crate::error::{DecodeError, IoError};
-
-/// Base colour (linear) of a material group the file gives no colour for: OBJ groups without a
-/// `Kd`, glTF primitives without a material.
-pub const DEFAULT_BASE_COLOR: Rgb = Rgb::splat(0.8);
-
-/// Name of the material group of faces or primitives the file assigns no material to.
-pub const DEFAULT_MATERIAL_NAME: &str = "default";
+use super::{
+    DEFAULT_BASE_COLOR, DEFAULT_MATERIAL_NAME, LoadedMesh, MeshLimits, finish, normalize_or_keep,
+};
+use crate::error::DecodeError;
 
 /// The glTF extension for Draco-compressed geometry.
 const DRACO: &str = "KHR_draco_mesh_compression";
-
-/// Size limits checked before allocating.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct MeshLimits {
-    /// Most triangles in the whole mesh, every glTF node instance counted (default 20 million).
-    /// Vertices are bounded by three times this.
-    pub max_triangles: usize,
-    /// Largest file read, in bytes (default 1 GiB); a `.gltf` and its external buffer files
-    /// together, an `.obj` and each `.mtl` on its own.
-    pub max_file_bytes: u64,
-}
-
-impl Default for MeshLimits {
-    fn default() -> Self {
-        MeshLimits {
-            max_triangles: 20_000_000,
-            max_file_bytes: 1 << 30,
-        }
-    }
-}
-
-impl MeshLimits {
-    fn max_vertices(&self) -> u64 {
-        (self.max_triangles as u64)
-            .saturating_mul(3)
-            .min(u64::from(u32::MAX))
-    }
-}
-
-/// A mesh read from a file, in the model's own frame, with its material groups' base colours.
-#[derive(Clone, Debug, PartialEq)]
-pub struct LoadedMesh {
-    /// The validated mesh (zero-area triangles already dropped).
-    pub mesh: TriangleMesh,
-    /// Linear base colour (diffuse albedo) of each entry of `mesh.material_names`: glTF
-    /// `baseColorFactor.rgb`, OBJ `Kd`, else [`DEFAULT_BASE_COLOR`].
-    pub base_colors: Vec<Rgb>,
-    /// Human-readable summary, e.g. `"glTF 2.0 binary, 2826 vertices, 5648 triangles, vertex
-    /// normals, 1 material"`, followed by notes on anything dropped or skipped.
-    pub details: String,
-}
-
-/// Reads a mesh file, choosing the format by extension (case-insensitive): `.gltf`/`.glb`
-/// (glTF 2.0, JSON or binary either way) or `.obj` (plus the `.mtl` files it names, looked up
-/// next to it). Every error names the file (or the `.mtl` file at fault) and, for bad content,
-/// is [`IoError::is_bad_input`].
-pub fn read_mesh(path: &Path, limits: &MeshLimits) -> Result<LoadedMesh, IoError> {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
-    let is_gltf = match ext.as_deref() {
-        Some("gltf" | "glb") => true,
-        Some("obj") => false,
-        _ => {
-            return Err(IoError::Unsupported {
-                path: path.to_path_buf(),
-                what: "mesh file extension (expected .gltf, .glb or .obj)".into(),
-            });
-        }
-    };
-    let bytes = read_bounded(path, limits.max_file_bytes)?;
-    let dir = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    if is_gltf {
-        decode_gltf_in(&bytes, Some(dir), limits).map_err(|e| e.with_path(path))
-    } else {
-        read_obj(path, dir, &bytes, limits)
-    }
-}
-
-/// Reads a whole file after checking its size against `max_bytes`.
-fn read_bounded(path: &Path, max_bytes: u64) -> Result<Vec<u8>, IoError> {
-    let len = std::fs::metadata(path)
-        .map_err(|e| IoError::read(path, e))?
-        .len();
-    if len > max_bytes {
-        return Err(IoError::Limits {
-            path: path.to_path_buf(),
-            what: format!("{len} bytes, over the limit of {max_bytes}"),
-        });
-    }
-    std::fs::read(path).map_err(|e| IoError::read(path, e))
-}
-
-// ---------------------------------------------------------------------------------------------
-// glTF
-// ---------------------------------------------------------------------------------------------
 
 /// Decodes glTF 2.0 bytes, binary (`.glb`) or JSON (`.gltf`), whose buffers are all embedded (the
 /// GLB binary chunk or base64 `data:` URIs); a buffer in an external file is
@@ -166,7 +49,7 @@ pub fn decode_gltf(bytes: &[u8], limits: &MeshLimits) -> Result<LoadedMesh, Deco
 }
 
 /// [`decode_gltf`] with external buffer files resolved in `base_dir` (none: refused).
-fn decode_gltf_in(
+pub(super) fn decode_gltf_in(
     bytes: &[u8],
     base_dir: Option<&Path>,
     limits: &MeshLimits,
@@ -397,9 +280,9 @@ impl<'a> Buffers<'a> {
                     "buffer {index}: data: URI that is not base64"
                 )));
             }
-            return decode_base64(payload)
-                .map(Cow::Owned)
-                .map_err(|e| DecodeError::invalid(format!("buffer {index}: data: URI: {e}")));
+            return decode_base64(payload).map(Cow::Owned).map_err(|e| {
+                DecodeError::invalid(format!("buffer {index}: data: URI is not base64: {e}"))
+            });
         }
         let Some(dir) = self.base_dir else {
             return Err(DecodeError::Unsupported(format!(
@@ -439,49 +322,30 @@ impl<'a> Buffers<'a> {
     }
 }
 
-/// Decodes standard or URL-safe base64; padding ends the data, anything else that is not in
-/// the alphabet is an error.
-fn decode_base64(text: &str) -> Result<Vec<u8>, String> {
-    let mut out = Vec::with_capacity(text.len() / 4 * 3 + 2);
-    let mut acc = 0u32;
-    let mut bits = 0u32;
-    for (i, c) in text.bytes().enumerate() {
-        let value = match c {
-            b'A'..=b'Z' => c - b'A',
-            b'a'..=b'z' => c - b'a' + 26,
-            b'0'..=b'9' => c - b'0' + 52,
-            b'+' | b'-' => 62,
-            b'/' | b'_' => 63,
-            b'=' => break,
-            _ => return Err(format!("byte {i} ({:?}) is not base64", char::from(c))),
-        };
-        acc = (acc << 6) | u32::from(value);
-        bits += 6;
-        if bits >= 8 {
-            bits -= 8;
-            out.push((acc >> bits) as u8);
-            acc &= (1 << bits) - 1;
-        }
-    }
-    Ok(out)
+/// Decodes the base64 payload of a `data:` URI: the standard alphabet (RFC 4648 section 4, as
+/// RFC 2397 uses), or the URL-safe one (section 5) that some exporters write; padding optional.
+fn decode_base64(text: &str) -> Result<Vec<u8>, base64::DecodeError> {
+    use base64::Engine as _;
+    use base64::alphabet::{STANDARD, URL_SAFE};
+    use base64::engine::{DecodePaddingMode, GeneralPurpose, GeneralPurposeConfig};
+    let config = GeneralPurposeConfig::new()
+        .with_decode_padding_mode(DecodePaddingMode::Indifferent)
+        .with_decode_allow_trailing_bits(true);
+    GeneralPurpose::new(&STANDARD, config)
+        .decode(text)
+        .or_else(|e| {
+            GeneralPurpose::new(&URL_SAFE, config)
+                .decode(text)
+                .map_err(|_| e)
+        })
 }
 
-/// Undoes `%XX` escapes of a URI path; `None` for a bad escape or non-UTF-8 result.
+/// Undoes `%XX` escapes of a URI path; `None` for a non-UTF-8 result.
 fn percent_decode(uri: &str) -> Option<PathBuf> {
-    let bytes = uri.as_bytes();
-    let mut out = Vec::with_capacity(bytes.len());
-    let mut i = 0;
-    while i < bytes.len() {
-        if bytes[i] == b'%' {
-            let hex = std::str::from_utf8(bytes.get(i + 1..i + 3)?).ok()?;
-            out.push(u8::from_str_radix(hex, 16).ok()?);
-            i += 3;
-        } else {
-            out.push(bytes[i]);
-            i += 1;
-        }
-    }
-    String::from_utf8(out).ok().map(PathBuf::from)
+    percent_encoding::percent_decode_str(uri)
+        .decode_utf8()
+        .ok()
+        .map(|path| PathBuf::from(path.as_ref()))
 }
 
 /// An accessor's elements, bounds-checked: element `i` is `bytes[i * stride..][..size]`.
@@ -931,17 +795,6 @@ impl<'l> GltfBuilder<'l> {
     }
 }
 
-/// `v / |v|`, or `v` itself when it has no direction (zero, or not finite), for [`finish`] to
-/// drop or [`TriangleMesh::validate`] to refuse.
-fn normalize_or_keep(v: Vec3) -> Vec3 {
-    let length = v.length();
-    if length > 0.0 && length.is_finite() {
-        v / length
-    } else {
-        v
-    }
-}
-
 /// The local transform of a node: its `matrix` (column-major) or `T * R * S`.
 fn local_transform(node: &json::Node) -> Mat4 {
     if let Some(m) = &node.matrix {
@@ -1016,347 +869,4 @@ fn walk_scene(
         }
     }
     Ok(())
-}
-
-// ---------------------------------------------------------------------------------------------
-// OBJ
-// ---------------------------------------------------------------------------------------------
-
-/// An OBJ file parsed, before material colours and validation.
-struct ParsedObj {
-    mesh: TriangleMesh,
-    /// File names from `mtllib` lines, in order.
-    material_libraries: Vec<String>,
-    /// Notes for the details line.
-    notes: Vec<String>,
-}
-
-/// Decodes Wavefront OBJ bytes; `mtl` is the content of its material library, if any (the
-/// `mtllib` lines themselves are not followed). The mesh is validated. Never panics.
-pub fn decode_obj(
-    obj: &[u8],
-    mtl: Option<&[u8]>,
-    limits: &MeshLimits,
-) -> Result<LoadedMesh, DecodeError> {
-    let parsed = parse_obj(obj, limits)?;
-    let colors = match mtl {
-        Some(m) => {
-            parse_mtl(m).map_err(|e| DecodeError::invalid(format!("material library: {e}")))?
-        }
-        None => HashMap::new(),
-    };
-    let base_colors = base_colors_of(&parsed.mesh.material_names, &colors);
-    finish(parsed.mesh, base_colors, "Wavefront OBJ", parsed.notes)
-}
-
-/// Reads an OBJ file and the `.mtl` files it names.
-fn read_obj(
-    path: &Path,
-    dir: &Path,
-    bytes: &[u8],
-    limits: &MeshLimits,
-) -> Result<LoadedMesh, IoError> {
-    let mut parsed = parse_obj(bytes, limits).map_err(|e| e.with_path(path))?;
-    let mut colors = HashMap::new();
-    for library in std::mem::take(&mut parsed.material_libraries) {
-        // `mtllib a.mtl b.mtl` names two files, but exporters also write unquoted names with
-        // spaces: the whole argument is tried first.
-        let whole = dir.join(&library);
-        let files: Vec<PathBuf> = if whole.is_file() {
-            vec![whole]
-        } else {
-            library.split_whitespace().map(|f| dir.join(f)).collect()
-        };
-        for file in files {
-            if !file.is_file() {
-                parsed.notes.push(format!(
-                    "material library {} not found, default base colours",
-                    file.display()
-                ));
-                continue;
-            }
-            let text = read_bounded(&file, limits.max_file_bytes)?;
-            let found = parse_mtl(&text).map_err(|e| e.with_path(&file))?;
-            colors.extend(found);
-        }
-    }
-    let base_colors = base_colors_of(&parsed.mesh.material_names, &colors);
-    finish(parsed.mesh, base_colors, "Wavefront OBJ", parsed.notes).map_err(|e| e.with_path(path))
-}
-
-fn base_colors_of(names: &[String], colors: &HashMap<String, Rgb>) -> Vec<Rgb> {
-    names
-        .iter()
-        .map(|n| colors.get(n).copied().unwrap_or(DEFAULT_BASE_COLOR))
-        .collect()
-}
-
-/// The text of a line without its comment, and its arguments after the keyword.
-fn obj_line(raw: &[u8]) -> Cow<'_, str> {
-    let line = String::from_utf8_lossy(raw);
-    match line.find('#') {
-        Some(hash) => Cow::Owned(line[..hash].to_owned()),
-        None => line,
-    }
-}
-
-fn parse_floats<const N: usize>(
-    mut words: std::str::SplitWhitespace<'_>,
-    line: usize,
-    keyword: &str,
-) -> Result<[f32; N], DecodeError> {
-    let mut out = [0.0f32; N];
-    for value in &mut out {
-        let word = words.next().ok_or_else(|| {
-            DecodeError::invalid(format!("line {line}: {keyword} needs {N} numbers"))
-        })?;
-        *value = word.parse().map_err(|_| {
-            DecodeError::invalid(format!("line {line}: {keyword}: {word:?} is not a number"))
-        })?;
-    }
-    Ok(out)
-}
-
-/// Resolves a 1-based or negative OBJ index against the `defined` elements so far.
-fn resolve_index(word: &str, defined: usize, line: usize, what: &str) -> Result<u32, DecodeError> {
-    let raw: i64 = word
-        .parse()
-        .map_err(|_| DecodeError::invalid(format!("line {line}: bad {what} index {word:?}")))?;
-    let defined = defined as i64;
-    let resolved = if raw < 0 {
-        defined.checked_add(raw)
-    } else {
-        Some(raw - 1)
-    };
-    match resolved {
-        Some(i) if raw != 0 && (0..defined).contains(&i) => Ok(i as u32),
-        _ => Err(DecodeError::invalid(format!(
-            "line {line}: {what} index {raw} out of range ({defined} defined so far)"
-        ))),
-    }
-}
-
-fn parse_obj(bytes: &[u8], limits: &MeshLimits) -> Result<ParsedObj, DecodeError> {
-    const NO_NORMAL: u32 = u32::MAX;
-    let mut positions: Vec<Vec3> = Vec::new();
-    let mut normals: Vec<Vec3> = Vec::new();
-    let mut mesh = TriangleMesh::default();
-    // (position index, normal index or NO_NORMAL) of each output vertex.
-    let mut vertex_of: HashMap<(u32, u32), u32> = HashMap::new();
-    let mut vertex_keys: Vec<(u32, u32)> = Vec::new();
-    let mut slot_of: HashMap<String, u32> = HashMap::new();
-    let mut slot: Option<u32> = None;
-    let mut material_libraries = Vec::new();
-    let mut corners_without_normal = 0usize;
-    let mut corners: Vec<u32> = Vec::new();
-    let mut slot_for = |name: &str, mesh: &mut TriangleMesh| -> u32 {
-        *slot_of.entry(name.to_owned()).or_insert_with(|| {
-            mesh.material_names.push(name.to_owned());
-            (mesh.material_names.len() - 1) as u32
-        })
-    };
-
-    for (number, raw) in bytes.split(|&b| b == b'\n').enumerate() {
-        let line = number + 1;
-        let text = obj_line(raw);
-        let mut words = text.split_whitespace();
-        let Some(keyword) = words.next() else {
-            continue;
-        };
-        let argument = || text.trim()[keyword.len()..].trim();
-        match keyword {
-            "v" => positions.push(Vec3::from_array(parse_floats::<3>(words, line, "v")?)),
-            "vn" => normals.push(Vec3::from_array(parse_floats::<3>(words, line, "vn")?)),
-            "f" => {
-                corners.clear();
-                for word in words {
-                    let mut parts = word.split('/');
-                    let v = parts.next().unwrap_or_default();
-                    let _texture = parts.next();
-                    let n = parts.next().filter(|n| !n.is_empty());
-                    if parts.next().is_some() {
-                        return Err(DecodeError::invalid(format!(
-                            "line {line}: bad face corner {word:?}"
-                        )));
-                    }
-                    let v = resolve_index(v, positions.len(), line, "vertex")?;
-                    let n = match n {
-                        Some(n) => resolve_index(n, normals.len(), line, "normal")?,
-                        None => {
-                            corners_without_normal += 1;
-                            NO_NORMAL
-                        }
-                    };
-                    let Ok(next) = u32::try_from(vertex_keys.len()) else {
-                        return Err(DecodeError::Limits(format!(
-                            "line {line}: more than {} vertices",
-                            u32::MAX
-                        )));
-                    };
-                    let vertex = *vertex_of.entry((v, n)).or_insert(next);
-                    if vertex == next {
-                        vertex_keys.push((v, n));
-                    }
-                    corners.push(vertex);
-                }
-                if corners.len() < 3 {
-                    return Err(DecodeError::invalid(format!(
-                        "line {line}: a face needs at least 3 corners, this one has {}",
-                        corners.len()
-                    )));
-                }
-                let total = mesh.triangles.len() + corners.len() - 2;
-                if total > limits.max_triangles {
-                    return Err(DecodeError::Limits(format!(
-                        "line {line}: more than {} triangles",
-                        limits.max_triangles
-                    )));
-                }
-                let s = match slot {
-                    Some(s) => s,
-                    None => *slot.insert(slot_for(DEFAULT_MATERIAL_NAME, &mut mesh)),
-                };
-                for i in 1..corners.len() - 1 {
-                    mesh.triangles
-                        .push([corners[0], corners[i], corners[i + 1]]);
-                    mesh.material_slots.push(s);
-                }
-            }
-            "usemtl" => {
-                let name = argument();
-                if name.is_empty() {
-                    return Err(DecodeError::invalid(format!(
-                        "line {line}: usemtl without a name"
-                    )));
-                }
-                slot = Some(slot_for(name, &mut mesh));
-            }
-            "mtllib" => {
-                let name = argument();
-                if !name.is_empty() {
-                    material_libraries.push(name.to_owned());
-                }
-            }
-            _ => {}
-        }
-    }
-
-    let mut notes = Vec::new();
-    mesh.positions = vertex_keys
-        .iter()
-        .map(|&(v, _)| positions[v as usize])
-        .collect();
-    if corners_without_normal == 0 {
-        mesh.normals = vertex_keys
-            .iter()
-            .map(|&(_, n)| normalize_or_keep(normals[n as usize]))
-            .collect();
-    } else if !normals.is_empty() {
-        notes.push(format!(
-            "normals dropped: {corners_without_normal} face corners have none"
-        ));
-    }
-    Ok(ParsedObj {
-        mesh,
-        material_libraries,
-        notes,
-    })
-}
-
-/// `Kd` of every `newmtl` of a material library.
-fn parse_mtl(bytes: &[u8]) -> Result<HashMap<String, Rgb>, DecodeError> {
-    let mut colors = HashMap::new();
-    let mut current: Option<String> = None;
-    for (number, raw) in bytes.split(|&b| b == b'\n').enumerate() {
-        let line = number + 1;
-        let text = obj_line(raw);
-        let mut words = text.split_whitespace();
-        match words.next() {
-            Some("newmtl") => {
-                let name = text.trim()["newmtl".len()..].trim();
-                if name.is_empty() {
-                    return Err(DecodeError::invalid(format!(
-                        "line {line}: newmtl without a name"
-                    )));
-                }
-                current = Some(name.to_owned());
-            }
-            Some("Kd") => {
-                let values: Vec<&str> = words.collect();
-                let parsed: Result<Vec<f32>, _> = values.iter().map(|w| w.parse()).collect();
-                let kd = match parsed.as_deref() {
-                    Ok([v]) => Rgb::splat(*v),
-                    Ok([r, g, b]) => Rgb::new(*r, *g, *b),
-                    _ => {
-                        return Err(DecodeError::Unsupported(format!(
-                            "line {line}: Kd {} (only one or three numbers are read)",
-                            values.join(" ")
-                        )));
-                    }
-                };
-                if ![kd.r, kd.g, kd.b]
-                    .iter()
-                    .all(|c| c.is_finite() && *c >= 0.0)
-                {
-                    return Err(DecodeError::invalid(format!(
-                        "line {line}: Kd must be finite and non-negative"
-                    )));
-                }
-                if let Some(name) = &current {
-                    colors.insert(name.clone(), kd);
-                }
-            }
-            _ => {}
-        }
-    }
-    Ok(colors)
-}
-
-// ---------------------------------------------------------------------------------------------
-// Common
-// ---------------------------------------------------------------------------------------------
-
-/// Drops unusable normals, validates, and writes the details line.
-fn finish(
-    mut mesh: TriangleMesh,
-    base_colors: Vec<Rgb>,
-    format: &str,
-    mut notes: Vec<String>,
-) -> Result<LoadedMesh, DecodeError> {
-    if mesh.triangles.is_empty() {
-        return Err(DecodeError::invalid("no triangles"));
-    }
-    if let Some(v) = mesh.normals.iter().position(|&n| n == Vec3::ZERO) {
-        notes.push(format!(
-            "normals dropped: vertex {v} has a zero-length normal"
-        ));
-        mesh.normals.clear();
-    }
-    let dropped = mesh
-        .validate()
-        .map_err(|e| DecodeError::invalid(e.to_string()))?;
-    if dropped > 0 {
-        notes.push(format!("{dropped} zero-area triangles dropped"));
-    }
-    let materials = mesh.material_names.len();
-    let mut details = format!(
-        "{format}, {} vertices, {} triangles, {}, {materials} material{}",
-        mesh.positions.len(),
-        mesh.triangles.len(),
-        if mesh.normals.is_empty() {
-            "flat shading (no normals)"
-        } else {
-            "vertex normals"
-        },
-        if materials == 1 { "" } else { "s" }
-    );
-    for note in notes {
-        details.push_str("; ");
-        details.push_str(&note);
-    }
-    Ok(LoadedMesh {
-        mesh,
-        base_colors,
-        details,
-    })
 }

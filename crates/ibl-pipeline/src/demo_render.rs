@@ -9,22 +9,22 @@
 //! light reference) with its table in `renders/report.md` and its chart as SVG and PNG.
 
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-use anyhow::Context;
+use ibl_core::tonemap::{Display, auto_exposure_stops};
 use ibl_core::{Image, Rgb};
 use ibl_eval::{RenderStudy, RenderStudySettings, render_study};
-use ibl_extract::{Method, ModelSpec};
-use ibl_io::{Display, WriteOptions};
-use ibl_render::lighting::LightingPlan;
+use ibl_extract::ModelSpec;
+use ibl_io::WriteOptions;
+use ibl_light::Method;
 use ibl_render::{RenderOutput, RenderSettings, render};
 use ibl_scene::{Camera, RenderMode, Scene, ShadowKind};
 use serde::Serialize;
 
-use crate::progress;
-
-/// Sub-folder of the renders.
-pub const RENDER_DIR: &str = "renders";
+use crate::demo_paths::{RENDER_DIR, relative};
+use crate::error::{Context, Result};
+use crate::lighting_plan::LightingPlan;
+use crate::progress::{Progress, rows};
 /// Width of the demo's perspective renders (the scenes' views are 4:3).
 const VIEW_WIDTH: u32 = 320;
 /// Width of the demo's panorama composites.
@@ -69,31 +69,22 @@ pub struct SceneResult {
     pub chart: [String; 2],
 }
 
-/// The example scenes bundled with iblkit.
-pub fn default_scene_dir() -> PathBuf {
-    crate::cmd::demo::assets_dir().join("scenes")
-}
-
 /// The study's methods: every light extraction method (median cut only at powers of two).
 fn study_methods() -> Vec<ModelSpec> {
     Method::ALL.into_iter().map(ModelSpec::from).collect()
 }
 
 /// Relative MSE and mean FLIP of `test` against `reference`.
-fn against(test: &Image<Rgb>, reference: &Image<Rgb>) -> anyhow::Result<(f64, f64)> {
-    let d = ibl_eval::ImageDifference::between(test, reference, None)?;
-    let f = ibl_eval::flip(test, reference, &ibl_eval::FlipOptions::default())?;
+fn against(test: &Image<Rgb>, reference: &Image<Rgb>) -> Result<(f64, f64)> {
+    let d = ibl_metrics::ImageDifference::between(test, reference, None)?;
+    let f = ibl_metrics::flip(test, reference, &ibl_metrics::FlipOptions::default())?;
     Ok((d.relative_mse, f.mean()))
 }
 
-/// Renders every scene in `dir` into `out/renders/`.
-pub fn demo_renders(dir: &Path, out: &Path) -> anyhow::Result<Vec<SceneResult>> {
-    let mut scenes: Vec<PathBuf> = std::fs::read_dir(dir)
-        .with_context(|| format!("{}: cannot list the example scenes", dir.display()))?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
-        .collect();
-    scenes.sort();
+/// Renders every scene (`*.toml`) in `dir` into `out/renders/`.
+pub fn demo_renders(dir: &Path, out: &Path, progress: &dyn Progress) -> Result<Vec<SceneResult>> {
+    let mut scenes = ibl_io::list_dir(dir)?;
+    scenes.retain(|p| p.extension().is_some_and(|e| e == "toml"));
     let mut results = Vec::new();
     for path in scenes {
         let name = path
@@ -101,8 +92,8 @@ pub fn demo_renders(dir: &Path, out: &Path) -> anyhow::Result<Vec<SceneResult>> 
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default();
         results.push(
-            demo_scene(&path, &name, out)
-                .with_context(|| format!("demo render of {}", path.display()))?,
+            demo_scene(&path, &name, out, progress)
+                .context(format!("demo render of {}", path.display()))?,
         );
     }
     let md = results
@@ -154,15 +145,15 @@ fn write_render(
     image: &Image<Rgb>,
     display: &WriteOptions,
     seconds: f64,
-) -> anyhow::Result<RenderedImage> {
+) -> Result<RenderedImage> {
     let exr = dir.join(format!("{stem}.exr"));
     let png = dir.join(format!("{stem}.png"));
     ibl_io::write_image(&exr, image, &WriteOptions::default())?;
     ibl_io::write_image(&png, image, display)?;
     Ok(RenderedImage {
         caption,
-        preview: crate::cmd::demo::relative(out, &png),
-        exr: crate::cmd::demo::relative(out, &exr),
+        preview: relative(out, &png),
+        exr: relative(out, &exr),
         seconds,
         against_reference: None,
     })
@@ -172,19 +163,36 @@ fn timed_render(
     scene: &Scene,
     plan: &LightingPlan,
     settings: &RenderSettings,
-) -> anyhow::Result<(RenderOutput, f64)> {
+) -> Result<(RenderOutput, f64)> {
     let started = std::time::Instant::now();
     let (lighting, _) = plan.build(scene)?;
     let output = render(scene, &lighting, settings, &|_, _| {})?;
     Ok((output, started.elapsed().as_secs_f64()))
 }
 
-fn demo_scene(path: &Path, name: &str, out: &Path) -> anyhow::Result<SceneResult> {
+fn demo_scene(path: &Path, name: &str, out: &Path, progress: &dyn Progress) -> Result<SceneResult> {
     let loaded = ibl_io::read_scene(path)?;
     let scene = loaded.scene;
     let dir = out.join(RENDER_DIR).join(name);
-    std::fs::create_dir_all(&dir).with_context(|| format!("{}: cannot create", dir.display()))?;
-    let bar = progress::bar(name, (SHOWCASE_COUNTS.len() + 3) as u64);
+    ibl_io::create_dir_all(&dir)?;
+    let steps = (SHOWCASE_COUNTS.len() + 3) as u64;
+    progress.begin(name, steps);
+    let showcase = showcase(&scene, &dir, out, &mut |done| {
+        progress.update(done, steps, None);
+    });
+    progress.end();
+    let (images, display) = showcase?;
+    study(&scene, name, &dir, out, &display, images, progress)
+}
+
+/// The showcase renders of a scene into `dir` (`step(done)` after each group), and the display
+/// transform every preview of the scene shares (the reference background's exposure).
+fn showcase(
+    scene: &Scene,
+    dir: &Path,
+    out: &Path,
+    step: &mut dyn FnMut(u64),
+) -> Result<(Vec<RenderedImage>, WriteOptions)> {
     let settings = RenderSettings {
         composite: scene.render.composite,
         width: Some(VIEW_WIDTH),
@@ -192,7 +200,7 @@ fn demo_scene(path: &Path, name: &str, out: &Path) -> anyhow::Result<SceneResult
         bounces: scene.render.bounces,
         seed: scene.render.seed,
     };
-    let base = LightingPlan::from_scene(&scene);
+    let base = LightingPlan::from_scene(scene);
     let mut images = Vec::new();
 
     // The reference, its layers, and the exposure every preview of the scene shares.
@@ -200,10 +208,10 @@ fn demo_scene(path: &Path, name: &str, out: &Path) -> anyhow::Result<SceneResult
         mode: RenderMode::Reference,
         ..base.clone()
     };
-    let (reference, seconds) = timed_render(&scene, &reference_plan, &settings)?;
+    let (reference, seconds) = timed_render(scene, &reference_plan, &settings)?;
     let display = WriteOptions {
         display: Display {
-            exposure_stops: ibl_io::tonemap::auto_exposure_stops(&reference.background),
+            exposure_stops: auto_exposure_stops(&reference.background),
             ..Display::default()
         },
         ..WriteOptions::default()
@@ -215,8 +223,8 @@ fn demo_scene(path: &Path, name: &str, out: &Path) -> anyhow::Result<SceneResult
                    image: &Image<Rgb>,
                    seconds: f64,
                    error: Option<(f64, f64)>|
-     -> anyhow::Result<()> {
-        let mut written = write_render(out, &dir, stem, caption, image, &display, seconds)?;
+     -> Result<()> {
+        let mut written = write_render(out, dir, stem, caption, image, &display, seconds)?;
         written.against_reference = error;
         images.push(written);
         Ok(())
@@ -254,21 +262,15 @@ fn demo_scene(path: &Path, name: &str, out: &Path) -> anyhow::Result<SceneResult
         0.0,
         None,
     )?;
-    bar.inc(1);
+    step(1);
 
     let lights_settings = RenderSettings {
         spp: LIGHTS_SPP,
         ..settings
     };
-    for n in SHOWCASE_COUNTS {
-        let plan = LightingPlan {
-            mode: RenderMode::Lights,
-            method: "median-cut".into(),
-            lights: n,
-            shadows: ShadowKind::Hard,
-            ..base.clone()
-        };
-        let (output, seconds) = timed_render(&scene, &plan, &lights_settings)?;
+    for (k, n) in SHOWCASE_COUNTS.into_iter().enumerate() {
+        let plan = LightingPlan::median_cut(scene, RenderMode::Lights, n);
+        let (output, seconds) = timed_render(scene, &plan, &lights_settings)?;
         add(
             &format!("lights-median-cut-{n}"),
             format!("{n} median-cut lights, hard shadows, {LIGHTS_SPP} spp"),
@@ -276,15 +278,13 @@ fn demo_scene(path: &Path, name: &str, out: &Path) -> anyhow::Result<SceneResult
             seconds,
             Some(against(&output.composite, &reference_composite)?),
         )?;
-        bar.inc(1);
+        step(2 + k as u64);
     }
     let hybrid_plan = LightingPlan {
-        mode: RenderMode::Hybrid,
-        method: "median-cut".into(),
-        lights: 16,
-        ..base.clone()
+        shadows: base.shadows,
+        ..LightingPlan::median_cut(scene, RenderMode::Hybrid, 16)
     };
-    let (hybrid, seconds) = timed_render(&scene, &hybrid_plan, &lights_settings)?;
+    let (hybrid, seconds) = timed_render(scene, &hybrid_plan, &lights_settings)?;
     add(
         "hybrid",
         format!(
@@ -296,7 +296,7 @@ fn demo_scene(path: &Path, name: &str, out: &Path) -> anyhow::Result<SceneResult
         seconds,
         Some(against(&hybrid.composite, &reference_composite)?),
     )?;
-    bar.inc(1);
+    step(2 + SHOWCASE_COUNTS.len() as u64);
 
     // The whole panorama, when the background is the probe.
     if matches!(scene.background, ibl_scene::Background::Panorama) {
@@ -319,10 +319,21 @@ fn demo_scene(path: &Path, name: &str, out: &Path) -> anyhow::Result<SceneResult
             None,
         )?;
     }
-    bar.inc(1);
-    bar.finish_and_clear();
+    step(3 + SHOWCASE_COUNTS.len() as u64);
+    Ok((images, display))
+}
 
-    // The study: every method at every N against a direct-light reference.
+/// The study of a scene (every method at every N against a direct-light reference) with its
+/// images under `dir/study/` and its chart beside `renders/report.md`.
+fn study(
+    scene: &Scene,
+    name: &str,
+    dir: &Path,
+    out: &Path,
+    display: &WriteOptions,
+    images: Vec<RenderedImage>,
+    progress: &dyn Progress,
+) -> Result<SceneResult> {
     let study_settings = RenderStudySettings {
         methods: study_methods(),
         counts: STUDY_COUNTS.to_vec(),
@@ -334,80 +345,36 @@ fn demo_scene(path: &Path, name: &str, out: &Path) -> anyhow::Result<SceneResult
         seed: scene.render.seed,
     };
     let runs = study_settings.methods.len() * study_settings.counts.len() + 2;
-    let bar = progress::bar(&format!("{name}: study"), runs as u64);
-    let (study, study_images) = render_study(
-        &scene,
-        name,
-        &study_settings,
-        &progress::rows_callback(&bar),
-    )?;
-    bar.finish_and_clear();
+    progress.begin(&format!("{name}: study"), runs as u64);
+    let studied = render_study(scene, name, &study_settings, &rows(progress));
+    progress.end();
+    let (study, study_images) = studied?;
     let study_dir = dir.join("study");
-    std::fs::create_dir_all(&study_dir)
-        .with_context(|| format!("{}: cannot create", study_dir.display()))?;
+    ibl_io::create_dir_all(&study_dir)?;
     ibl_io::write_image(
         &study_dir.join("reference.png"),
         &study_images.reference.with_objects,
-        &display,
+        display,
     )?;
     for (method, n, output) in &study_images.lights {
         ibl_io::write_image(
             &study_dir.join(format!("{method}-{n}.png")),
             &output.with_objects,
-            &display,
+            display,
         )?;
     }
     let chart = study.chart();
     let svg = ibl_eval::render_svg(&chart, ibl_eval::PLOT_SIZE)?;
     let svg_path = out.join(RENDER_DIR).join(format!("{name}-study.svg"));
     ibl_io::write_atomically(&svg_path, svg.as_bytes())?;
-    let png = ibl_io::ldr::encode_png(&ibl_eval::render_png(&chart, ibl_eval::PLOT_SIZE)?)
-        .context("encoding the study chart")?;
     let png_path = out.join(RENDER_DIR).join(format!("{name}-study.png"));
+    let png = ibl_io::ldr::encode_png(&ibl_eval::render_png(&chart, ibl_eval::PLOT_SIZE)?)
+        .map_err(|e| e.with_path(&png_path))?;
     ibl_io::write_atomically(&png_path, &png)?;
     Ok(SceneResult {
         name: name.to_string(),
         images,
         study,
-        chart: [
-            crate::cmd::demo::relative(out, &svg_path),
-            crate::cmd::demo::relative(out, &png_path),
-        ],
+        chart: [relative(out, &svg_path), relative(out, &png_path)],
     })
-}
-
-/// The renders section of the demo's `index.html`.
-pub fn renders_html(results: &[SceneResult]) -> String {
-    let mut html = String::from(
-        "<h1 id=renders>Virtual objects in real probes</h1>\
-         <p>The example scenes of <code>assets/scenes/</code>, rendered by <code>ibl render</code>: \
-         the path-traced reference composited into the probe by differential rendering, light \
-         approximations, the hybrid, and the whole panorama. Then every light set scored by its \
-         render against the reference (<a href=\"renders/report.md\">renders/report.md</a>).</p>",
-    );
-    for r in results {
-        let _ = write!(html, "<h2>{}</h2>", r.name);
-        for image in &r.images {
-            let time = if image.seconds > 0.0 {
-                format!(" ({:.1} s)", image.seconds)
-            } else {
-                String::new()
-            };
-            let error = image
-                .against_reference
-                .map(|(relative_mse, flip)| {
-                    format!(
-                        "<br>against the reference: relative MSE {relative_mse:.2e}, FLIP {flip:.3}"
-                    )
-                })
-                .unwrap_or_default();
-            let _ = write!(
-                html,
-                "<figure><img src=\"{}\"><figcaption>{}{time}{error}</figcaption></figure>",
-                image.preview, image.caption
-            );
-        }
-        let _ = write!(html, "<p><img class=wide src=\"{}\"></p>", r.chart[1]);
-    }
-    html
 }
