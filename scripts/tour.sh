@@ -6,7 +6,7 @@
 #   scripts/tour.sh IBL_BINARY OUT_DIR
 #   scripts/tour.sh /work/baseline/ibl /tmp/tour-before
 #   scripts/tour.sh target/release/ibl /tmp/tour-after
-#   diff -r /tmp/tour-before /tmp/tour-after       # or scripts/tour-compare.sh
+#   python3 scripts/tour_compare.py /tmp/tour-before /tmp/tour-after
 #
 # Renders and the demo run at reduced sizes and sample counts to keep the tour to a few minutes.
 # Every command's stdout, stderr and exit status land beside its outputs (`NN-name.out`,

@@ -63,6 +63,8 @@ fn hybrid_conserves_power_and_tends_to_the_exact_irradiance() {
             let hybrid = Hybrid::from_probe(&probe, lights.clone(), bands, Window::None).unwrap();
             let got = hybrid.total_power();
             for c in 0..3 {
+                // Power is conserved exactly in SH (the lights' projections are subtracted); 1e-9
+                // relative covers the f64 sums over the probe's pixels and the bands.
                 assert!(
                     (got[c] - want[c]).abs() < 1e-9 * want[c],
                     "{name}: power {got:?} vs {want:?}"

@@ -77,6 +77,8 @@ fn every_hostile_file_errors_or_loads_as_documented() {
     for case in &cases {
         let path = corpus_dir().join(&case.name);
         let size = std::fs::metadata(&path).expect("file").len();
+        // A size bound, not a tolerance: the corpus files must stay small (64 KiB) to keep the
+        // repository light.
         assert!(size < 64 * 1024, "{} is {size} bytes", case.name);
         let outcome = std::panic::catch_unwind(|| read_image(&path));
         let Ok(result) = outcome else {

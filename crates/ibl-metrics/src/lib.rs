@@ -6,6 +6,8 @@
 //!   `rel_max%`; CONVENTIONS section 5, Madsen & Laursen 2006 section 5);
 //! * [`image_difference`]: RMSE, relative MSE, absolute errors, PSNR and per-pixel error maps
 //!   between two images, with percentiles of any map;
+//! * [`probe_difference`]: the relative MAE of luminance between two lat-long probes, weighted by
+//!   solid angle (capture's tests);
 //! * [`mod@flip`]: the FLIP perceptual difference map (Andersson et al. 2020, HDR-FLIP 2021),
 //!   checked against NVIDIA's reference implementation (`tests/flip_reference.rs`);
 //! * [`comparison`]: the size and mask checks they share, and their error.
@@ -17,6 +19,7 @@ pub mod comparison;
 pub mod flip;
 pub mod image_difference;
 pub mod irradiance_error;
+pub mod probe_difference;
 
 pub use comparison::DifferenceError;
 pub use flip::{DEFAULT_PIXELS_PER_DEGREE, Flip, FlipOptions, FlipRange, flip};
@@ -27,3 +30,4 @@ pub use image_difference::{
 pub use irradiance_error::{
     IrradianceError, max_err_pct, mean_err_pct, rel_max_err_pct, rel_mean_err_pct,
 };
+pub use probe_difference::relative_luminance_mae;

@@ -18,7 +18,7 @@
 //! read. Base colours are `baseColorFactor.rgb` (linear; the specification's default is 1), and
 //! 0.8 grey ([`DEFAULT_BASE_COLOR`]) for primitives without a material.
 //!
-//! Normals, validation and the details line: see [`super`].
+//! Normals, validation and the details line: see [`super::loaded`].
 
 use std::borrow::Cow;
 use std::collections::HashMap;
@@ -32,7 +32,7 @@ use ibl_core::Rgb;
 use ibl_core::glam::{Mat3, Mat4, Quat, Vec3};
 use ibl_scene::TriangleMesh;
 
-use super::{
+use super::loaded::{
     DEFAULT_BASE_COLOR, DEFAULT_MATERIAL_NAME, LoadedMesh, MeshLimits, finish, normalize_or_keep,
 };
 use crate::error::DecodeError;

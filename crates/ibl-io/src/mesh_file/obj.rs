@@ -10,7 +10,7 @@
 //! form `"default"`); its base colour is the `Kd` of the `.mtl` files named by `mtllib` and found
 //! next to the `.obj`; a missing `.mtl` only leaves 0.8 grey.
 //!
-//! Normals, validation and the details line: see [`super`].
+//! Normals, validation and the details line: see [`super::loaded`].
 
 use std::borrow::Cow;
 use std::collections::HashMap;
@@ -20,7 +20,7 @@ use ibl_core::Rgb;
 use ibl_core::glam::Vec3;
 use ibl_scene::TriangleMesh;
 
-use super::{
+use super::loaded::{
     DEFAULT_BASE_COLOR, DEFAULT_MATERIAL_NAME, LoadedMesh, MeshLimits, finish, normalize_or_keep,
 };
 use crate::error::{DecodeError, IoError};
