@@ -64,7 +64,7 @@ use ibl_light::{Extraction, FitReport, Light, LightSet, Provenance};
 use nalgebra::{DMatrix, DMatrixViewMut, DVector};
 use rayon::prelude::*;
 
-use crate::cholesky::{cholesky_in_place, cholesky_solve};
+use crate::cholesky::solve_spd;
 use crate::lune_gram::{cosine_overlap, feature_block};
 use crate::normal_lanes::{ChannelValues, NormalLanes};
 use crate::{ExtractError, nnls_gram};
@@ -786,11 +786,7 @@ fn levenberg_marquardt(
             for i in 0..np {
                 a[(i, i)] += lambda * h[(i, i)].max(floor);
             }
-            let delta = if cholesky_in_place(&mut a) {
-                cholesky_solve(&a, &(-&g))
-            } else {
-                None
-            };
+            let delta = solve_spd(&a, &(-&g));
             let Some(delta) = delta else {
                 lambda *= nu;
                 nu *= 2.0;
