@@ -279,10 +279,16 @@ fn synthetic_marks(sigma: f64, seed: u64) -> (MarksFile, Synth) {
 
 fn angle_deg(a: DMat3, b: DMat3) -> f64 {
     let m = a.transpose() * b;
-    ((m.x_axis.x + m.y_axis.y + m.z_axis.z - 1.0) / 2.0)
-        .clamp(-1.0, 1.0)
-        .acos()
-        .to_degrees()
+    // atan2 of the rotation's sine and cosine: accurate for small angles (acos is not).
+    let skew = glam::DVec3::new(
+        m.y_axis.z - m.z_axis.y,
+        m.z_axis.x - m.x_axis.z,
+        m.x_axis.y - m.y_axis.x,
+    );
+    let angle = (0.5 * skew.length())
+        .atan2(0.5 * (m.x_axis.x + m.y_axis.y + m.z_axis.z - 1.0))
+        .to_degrees();
+    angle
 }
 
 #[test]
