@@ -48,11 +48,14 @@ pub enum HiddenRadiosity {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum GroupAverage {
-    /// Each seen patch counts once (the paper).
+    /// The mean of the seen patches' `B / E`, each counting once (the paper).
     PatchMean,
-    /// Each seen patch counts by the area the probe sees of it.
+    /// The ratio `sum_p w_p B_p / sum_p w_p E_p` over the seen patches, `w_p` the area the probe
+    /// sees of each: noise in a patch's `E` (form-factor sampling) averages out before the
+    /// division instead of biasing every `B / E` upwards (`1 / E` is convex: measured +1 % on
+    /// the synthetic room with 900 rays per patch).
     #[default]
-    SeenArea,
+    SeenAreaRatio,
 }
 
 /// Settings of the estimate.
@@ -74,7 +77,7 @@ impl Default for EstimationSettings {
             tolerance: 0.002,
             max_iterations: 10,
             hidden: HiddenRadiosity::Solved,
-            average: GroupAverage::SeenArea,
+            average: GroupAverage::SeenAreaRatio,
         }
     }
 }
@@ -397,7 +400,9 @@ fn group_reflectances(
     average: GroupAverage,
 ) -> Result<(Vec<Option<Rgb>>, Vec<bool>), RoomError> {
     let groups = room.groups.len();
-    let mut sum = vec![[0.0f64; 3]; groups];
+    // Per group: numerator and denominator sums per channel, and the total weight.
+    let mut top = vec![[0.0f64; 3]; groups];
+    let mut bottom = vec![[0.0f64; 3]; groups];
     let mut weight = vec![0.0f64; groups];
     for p in 0..role.len() {
         if role[p] != PatchRole::Seen {
@@ -407,16 +412,23 @@ fn group_reflectances(
             continue;
         };
         let g = room.patches[p].group as usize;
-        let w = match average {
-            GroupAverage::PatchMean => 1.0,
-            GroupAverage::SeenArea => {
-                f64::from(room.patches[p].area_m2 * observations.patches[p].seen_fraction)
+        match average {
+            GroupAverage::PatchMean => {
+                for (c, r) in rho.to_array().iter().enumerate() {
+                    top[g][c] += f64::from(*r);
+                    bottom[g][c] += 1.0;
+                }
+                weight[g] += 1.0;
             }
-        };
-        sum[g][0] += w * f64::from(rho.r);
-        sum[g][1] += w * f64::from(rho.g);
-        sum[g][2] += w * f64::from(rho.b);
-        weight[g] += w;
+            GroupAverage::SeenAreaRatio => {
+                let w = f64::from(room.patches[p].area_m2 * observations.patches[p].seen_fraction);
+                for c in 0..3 {
+                    top[g][c] += w * f64::from(b[p][c]);
+                    bottom[g][c] += w * f64::from(e[p][c]);
+                }
+                weight[g] += w;
+            }
+        }
     }
     let own: Vec<bool> = (0..groups)
         .map(|g| room.groups[g].kind == GroupKind::Surface && weight[g] > 0.0)
@@ -424,11 +436,10 @@ fn group_reflectances(
     let mut rho: Vec<Option<Rgb>> = (0..groups)
         .map(|g| {
             own[g].then(|| {
-                let s = sum[g];
                 Rgb::new(
-                    (s[0] / weight[g]) as f32,
-                    (s[1] / weight[g]) as f32,
-                    (s[2] / weight[g]) as f32,
+                    (top[g][0] / bottom[g][0]) as f32,
+                    (top[g][1] / bottom[g][1]) as f32,
+                    (top[g][2] / bottom[g][2]) as f32,
                 )
             })
         })

@@ -246,6 +246,9 @@ pub struct Calibration {
     pub vanishing_points: Vec<VanishingPoint>,
     /// RMS angle between every line's circle and its axis in the refined frame, degrees.
     pub rms_residual_deg: f64,
+    /// Each line's angle to its axis in the refined frame, degrees, in the order given (a mark
+    /// far above the others is probably assigned to the wrong axis or misplaced).
+    pub line_residuals_deg: Vec<f64>,
     /// How far the refinement turned the paper's two-point axes, degrees.
     pub refinement_deg: f64,
 }
@@ -315,23 +318,20 @@ pub fn calibrate(lines: &[LineObservation]) -> Result<Calibration, RoomError> {
             }
         })
         .collect();
-    let all: Vec<&LineObservation> = lines.iter().collect();
-    let rms_residual_deg = {
-        let sq: f64 = all
-            .iter()
-            .map(|l| {
-                let a = l
-                    .normal
-                    .dot(refined.col(l.axis.index()))
-                    .abs()
-                    .min(1.0)
-                    .asin()
-                    .to_degrees();
-                a * a
-            })
-            .sum();
-        (sq / all.len().max(1) as f64).sqrt()
-    };
+    let line_residuals_deg: Vec<f64> = lines
+        .iter()
+        .map(|l| {
+            l.normal
+                .dot(refined.col(l.axis.index()))
+                .abs()
+                .min(1.0)
+                .asin()
+                .to_degrees()
+        })
+        .collect();
+    let rms_residual_deg = (line_residuals_deg.iter().map(|a| a * a).sum::<f64>()
+        / line_residuals_deg.len().max(1) as f64)
+        .sqrt();
     let world_from_probe = refined.transpose();
     let rows = [0, 1, 2].map(|r| world_from_probe.row(r).to_array());
     Ok(Calibration {
@@ -339,6 +339,7 @@ pub fn calibrate(lines: &[LineObservation]) -> Result<Calibration, RoomError> {
         rotation_deg: rotation_degrees(world_from_probe),
         vanishing_points,
         rms_residual_deg,
+        line_residuals_deg,
         refinement_deg,
     })
 }

@@ -37,10 +37,10 @@ fn synthetic_panorama(room: &Room, width: usize) -> Image<Rgb> {
 
 #[test]
 fn proposal_finds_the_rotation_within_a_degree() {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../assets/rooms/synthetic/room.toml");
-    let file = RoomFile::from_toml(&std::fs::read_to_string(path).expect("room file"))
-        .expect("parses");
+    let path =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../assets/rooms/synthetic/room.toml");
+    let file =
+        RoomFile::from_toml(&std::fs::read_to_string(path).expect("room file")).expect("parses");
     let truth = EulerDegrees {
         yaw_deg: 17.0,
         pitch_deg: 2.5,
