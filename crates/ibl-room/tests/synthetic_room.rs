@@ -22,7 +22,7 @@ fn synthetic_room_reflectances_match_the_rendered_albedos() {
     let probe = ibl_io::read_image(&dir.join(&file.probe.file))
         .expect("probe")
         .image;
-    eprintln!("probe {} x {}", probe.width(), probe.height());
+    assert!(probe.width() >= 1024 && probe.height() >= 512);
     let analysis =
         analyse_room(&room, &probe, &AnalysisSettings::default(), &|_, _, _| ()).expect("analysis");
     let important = important_patches(&room, &analysis.estimate, 16);
@@ -45,7 +45,9 @@ fn synthetic_room_reflectances_match_the_rendered_albedos() {
             .map(|c| (rho[c] - truth[c]).abs())
             .fold(0.0, f32::max);
         // Seen groups within 0.02, mostly hidden ones (under half their area seen) within 0.04
-        // (issue 16). The render's noise on a group's mean radiance is below 0.3 % (render.json).
+        // (issue 16). The render's noise on a group's mean radiance (render.json) is 0.2 % (wall) to
+        // 2.2 % (chest, the least seen) relative: 0.012 absolute at the chest's 0.55, one sigma.
+        // Measured largest errors: table 0.015, ceiling 0.012, chest 0.004.
         let bound = if g.seen_area_fraction < 0.5 {
             mostly_hidden += 1;
             0.04
