@@ -5,6 +5,8 @@
 //!
 //! `cargo bench -p ibl-room --bench estimate -- --warm-up-time 1 --measurement-time 10`
 
+#![allow(missing_docs)] // `criterion_group!` generates an undocumented function
+
 use std::path::PathBuf;
 
 use criterion::{Criterion, criterion_group, criterion_main};

@@ -10,7 +10,7 @@
 //! hole filling of a moved camera (section 4.4) needs. Cost: one ray per pixel, rows in
 //! parallel, identical for any thread count.
 
-use glam::{DVec3, Vec3};
+use glam::Vec3;
 use ibl_core::{Image, LatLong};
 use rayon::prelude::*;
 
@@ -129,8 +129,7 @@ impl ProbeDepthMap {
             return true;
         }
         let probe_dir = room.world_from_probe.transpose() * to_point;
-        let (i, j) = LatLong::new(self.width(), self.height())
-            .dir_to_pixel(DVec3::from(probe_dir.as_dvec3()));
+        let (i, j) = LatLong::new(self.width(), self.height()).dir_to_pixel(probe_dir.as_dvec3());
         self.sample(i, j).distance_m >= distance - tolerance_m
     }
 }

@@ -103,7 +103,7 @@ impl FormFactors {
         let rays = a * a * b * b;
         let n = room.patches.len();
         let done = AtomicUsize::new(0);
-        let rows: Vec<(Vec<(u32, f32)>, f32, f32)> = (0..n)
+        let rows: Vec<PatchRow> = (0..n)
             .into_par_iter()
             .map(|e| {
                 let row = patch_row(room, e, a, b, settings.seed);
@@ -192,8 +192,11 @@ impl FormFactors {
     }
 }
 
-/// The hits of patch `e`'s rays: sorted `(patch, fraction)` entries, escaped and back fractions.
-fn patch_row(room: &Room, e: usize, a: u32, b: u32, seed: u64) -> (Vec<(u32, f32)>, f32, f32) {
+/// One patch's row: sorted `(patch, fraction)` entries, then the escaped and back fractions.
+type PatchRow = (Vec<(u32, f32)>, f32, f32);
+
+/// The hits of patch `e`'s rays.
+fn patch_row(room: &Room, e: usize, a: u32, b: u32, seed: u64) -> PatchRow {
     let patch = &room.patches[e];
     let n = patch.normal;
     let (t1, t2) = tangents(n);

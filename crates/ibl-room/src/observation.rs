@@ -119,7 +119,7 @@ pub fn observe(
     let mut pixels = vec![0u32; n];
     let mut edge_pixels = 0usize;
     let world_from_probe = room.world_from_probe.as_dmat3();
-    for j in 0..h {
+    for (j, &solid_angle) in solid_angles.iter().enumerate() {
         for i in 0..w {
             let s = depth.sample(i, j);
             if s.patch == NO_PATCH {
@@ -128,7 +128,7 @@ pub fn observe(
             let p = s.patch as usize;
             let d = world_from_probe * latlong.pixel_dir64(i, j);
             let cos = (-d.dot(room.patches[p].normal.as_dvec3())).max(0.05);
-            let area = solid_angles[j] * f64::from(s.distance_m).powi(2) / cos;
+            let area = solid_angle * f64::from(s.distance_m).powi(2) / cos;
             seen_area[p] += area;
             let clean = (-margin..=margin).all(|dj| {
                 let jj = (j as i64 + dj).clamp(0, h as i64 - 1) as usize;

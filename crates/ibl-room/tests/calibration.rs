@@ -285,10 +285,9 @@ fn angle_deg(a: DMat3, b: DMat3) -> f64 {
         m.z_axis.x - m.x_axis.z,
         m.x_axis.y - m.y_axis.x,
     );
-    let angle = (0.5 * skew.length())
+    (0.5 * skew.length())
         .atan2(0.5 * (m.x_axis.x + m.y_axis.y + m.z_axis.z - 1.0))
-        .to_degrees();
-    angle
+        .to_degrees()
 }
 
 #[test]
