@@ -4,13 +4,14 @@
 //!
 //! Jacobi iteration: every sweep gathers `E = F B` from the previous sweep's radiosity (rows in
 //! parallel, each summed in order, so the result does not depend on the thread count) and
-//! updates the unknowns. With reflectances below 1 and form-factor rows summing to at most 1 the
+//! updates the unknowns; only the unknowns' rows are gathered until the last sweep. With reflectances below 1 and form-factor rows summing to at most 1 the
 //! error shrinks at least by the largest reflectance per sweep. It stops when no unknown changed
 //! by more than `tolerance` times the largest radiosity. Used for the furnace check (closed room,
 //! uniform emission: `B = E / (1 - rho)`), for the hidden patches of the reflectance estimate
 //! (section 3.2, step 4) and, later, for delta radiosity after material changes (section 4.3).
 
 use ibl_core::Rgb;
+use rayon::prelude::*;
 
 use crate::RoomError;
 use crate::form_factors::FormFactors;
@@ -71,31 +72,44 @@ pub fn solve_radiosity(
             PatchRadiosity::Unknown { .. } => b0,
         })
         .collect();
+    // Only the unknowns' rows are gathered per sweep (hidden patches are a small part of a room).
+    let unknown: Vec<usize> = (0..n)
+        .filter(|&k| matches!(patches[k], PatchRadiosity::Unknown { .. }))
+        .collect();
+    let scale_known = b
+        .iter()
+        .zip(patches)
+        .filter(|(_, p)| matches!(p, PatchRadiosity::Known(_)))
+        .map(|(v, _)| v.max_channel())
+        .fold(0.0f32, f32::max);
     let mut sweeps = 0;
-    let mut last_change = f32::INFINITY;
-    let mut e = form_factors.gather(&b);
-    while sweeps < max_sweeps {
+    let mut last_change = 0.0f32;
+    while sweeps < max_sweeps && !unknown.is_empty() {
         sweeps += 1;
+        let gathered: Vec<Rgb> = unknown
+            .par_iter()
+            .map(|&k| form_factors.gather_one(k, &b))
+            .collect();
         let mut change = 0.0f32;
-        let mut scale = 0.0f32;
-        for (k, p) in patches.iter().enumerate() {
+        let mut scale = scale_known;
+        for (&k, e) in unknown.iter().zip(gathered) {
             if let PatchRadiosity::Unknown {
                 emission,
                 reflectance,
-            } = *p
+            } = patches[k]
             {
-                let new = emission + reflectance * e[k];
+                let new = emission + reflectance * e;
                 change = change.max((new - b[k]).map(f32::abs).max_channel());
                 b[k] = new;
             }
             scale = scale.max(b[k].max_channel());
         }
-        e = form_factors.gather(&b);
         last_change = if scale > 0.0 { change / scale } else { 0.0 };
         if last_change <= tolerance {
             break;
         }
     }
+    let e = form_factors.gather(&b);
     Ok(RadiositySolution {
         radiosity: b,
         irradiance: e,
