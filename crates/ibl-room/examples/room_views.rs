@@ -126,38 +126,34 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let radiance = view.render(&probe);
         let mut picture = to_srgb8(&radiance, &display);
         if marks.is_none() || grid {
-            {
-                for y in 0..picture.height() {
-                    for x in 0..picture.width() {
-                        if x % 50 == 0 || y % 50 == 0 {
-                            let strong = x % 100 == 0 || y % 100 == 0;
-                            let p = picture.get_mut(x, y);
-                            *p = if strong {
-                                [255, 0, 255]
-                            } else {
-                                p.map(|c| c / 2 + 64)
-                            };
-                        }
+            for y in 0..picture.height() {
+                for x in 0..picture.width() {
+                    if x % 50 == 0 || y % 50 == 0 {
+                        let strong = x % 100 == 0 || y % 100 == 0;
+                        let p = picture.get_mut(x, y);
+                        *p = if strong {
+                            [255, 0, 255]
+                        } else {
+                            p.map(|c| c / 2 + 64)
+                        };
                     }
                 }
             }
         }
         if let Some(m) = &marks {
-            {
-                let v = m.views.iter().find(|v| &v.name == name).ok_or("view")?;
-                for l in &v.lines {
-                    let c = match l.axis {
-                        Axis::X => [255, 40, 40],
-                        Axis::Y => [40, 255, 40],
-                        Axis::Z => [60, 120, 255],
-                    };
-                    line(&mut picture, l.from, l.to, c);
-                }
-                for p in &v.points {
-                    let [x, y] = p.at;
-                    line(&mut picture, [x - 6.0, y], [x + 6.0, y], [255, 230, 0]);
-                    line(&mut picture, [x, y - 6.0], [x, y + 6.0], [255, 230, 0]);
-                }
+            let v = m.views.iter().find(|v| &v.name == name).ok_or("view")?;
+            for l in &v.lines {
+                let c = match l.axis {
+                    Axis::X => [255, 40, 40],
+                    Axis::Y => [40, 255, 40],
+                    Axis::Z => [60, 120, 255],
+                };
+                line(&mut picture, l.from, l.to, c);
+            }
+            for p in &v.points {
+                let [x, y] = p.at;
+                line(&mut picture, [x - 6.0, y], [x + 6.0, y], [255, 230, 0]);
+                line(&mut picture, [x, y - 6.0], [x, y + 6.0], [255, 230, 0]);
             }
         }
         if detect {
