@@ -1,4 +1,4 @@
-//! Reflectance estimation of the synthetic room (`assets/rooms/synthetic`, 2259 patches of at
+//! Reflectance estimation of the synthetic room (`assets/rooms/synthetic`, 2295 patches of at
 //! most 0.05 m^2, a 1024 x 512 probe): the whole of Grosch 2005 section 3.2 (depth map, probe
 //! radiosity, form factors by ray casting with 900 rays per patch, the iteration), and its
 //! stages alone. Issue 16's target: the whole under 2 s on 2 cores.
