@@ -14,7 +14,7 @@ use ibl_core::{FramePreset, Image, Rgb};
 use ibl_extract::{Light, LightSet};
 use ibl_io::{Display, WriteOptions};
 use ibl_render::lighting::LightingPlan;
-use ibl_render::{RenderOutput, RenderSettings};
+use ibl_render::{RenderOutput, RenderSettings, SamplerKind};
 use ibl_scene::{RenderMode, ShadowKind};
 use serde::Serialize;
 
@@ -51,6 +51,15 @@ pub enum ShadowArg {
     Soft,
 }
 
+/// Samplers on the command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum SamplerArg {
+    /// Owen-scrambled Sobol points (low discrepancy).
+    Sobol,
+    /// Independent uniform random numbers.
+    Independent,
+}
+
 /// Arguments of `ibl render`.
 #[derive(Args)]
 #[command(after_help = "\
@@ -61,6 +70,7 @@ Examples:
   ibl render scene.toml -o b.exr --mode lights --lights lights.json --shadows soft
   ibl render scene.toml -o h.exr --mode hybrid --method sun -n 1 --spp 16 --json
   ibl render scene.toml -o b.exr --width 640 --spp 256 --layers              + with/without/alpha
+  ibl render scene.toml -o b.exr --sampler independent                       no low discrepancy
 
 Writes OUT (EXR, or any format ibl writes) and OUT's .png preview, tone-mapped with the exposure
 of the background; --layers adds OUT-with, OUT-without (local scene with and without the objects)
@@ -88,9 +98,13 @@ pub struct RenderArgs {
     /// Hard or soft shadows (lights and hybrid).
     #[arg(long, value_enum)]
     pub shadows: Option<ShadowArg>,
-    /// Samples per pixel.
+    /// Samples per pixel (default: the scene's `[render] spp` for the reference, `[lighting] spp`
+    /// for the lights and hybrid modes).
     #[arg(long, value_name = "N")]
     pub spp: Option<u32>,
+    /// Random numbers of the samples (default: the scene's `[render] sampler`, sobol).
+    #[arg(long, value_enum)]
+    pub sampler: Option<SamplerArg>,
     /// Output width in pixels (panorama: height = width / 2; photo: its aspect ratio).
     #[arg(long, value_name = "W")]
     pub width: Option<u32>,
@@ -123,6 +137,7 @@ struct Summary {
     spp: u32,
     bounces: u32,
     seed: u64,
+    sampler: &'static str,
     seconds_lighting: f64,
     seconds_render: f64,
     rays: u64,
@@ -208,12 +223,18 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         }
         plan.given = Some(set);
     }
+    let defaults = RenderSettings::for_scene(scene, plan.mode);
     let settings = RenderSettings {
-        composite: scene.render.composite,
-        width: args.width.or(scene.render.width),
-        spp: args.spp.unwrap_or(scene.render.spp),
-        bounces: args.bounces.unwrap_or(scene.render.bounces),
-        seed: args.seed.unwrap_or(scene.render.seed),
+        width: args.width.or(defaults.width),
+        spp: args.spp.unwrap_or(defaults.spp),
+        bounces: args.bounces.unwrap_or(defaults.bounces),
+        seed: args.seed.unwrap_or(defaults.seed),
+        sampler: match args.sampler {
+            Some(SamplerArg::Sobol) => SamplerKind::Sobol,
+            Some(SamplerArg::Independent) => SamplerKind::Independent,
+            None => defaults.sampler,
+        },
+        ..defaults
     };
     check_settings(&settings)?;
 
@@ -249,6 +270,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         spp: stats.spp,
         bounces: settings.bounces,
         seed: settings.seed,
+        sampler: settings.sampler.name(),
         seconds_lighting,
         seconds_render,
         rays: stats.rays,

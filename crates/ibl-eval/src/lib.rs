@@ -47,7 +47,7 @@ pub use image_difference::{
 };
 pub use plot::{ErrorChart, PLOT_SIZE, PlotError, render_png, render_svg};
 pub use render_study::{
-    RenderStudy, RenderStudyImages, RenderStudyRow, RenderStudySettings, render_study,
+    RenderStudy, RenderStudyImages, RenderStudyRow, RenderStudySettings, StudyRun, render_study,
 };
 pub use report::{FigureFiles, LightsNeeded, PlotFiles, ReportFiles};
 pub use sphere_image::{SphereField, SphereFigure};

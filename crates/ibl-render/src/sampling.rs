@@ -30,7 +30,7 @@ use std::f32::consts::{FRAC_1_PI, FRAC_PI_4, PI, TAU};
 use glam::Vec3;
 
 /// `splitmix64` finaliser (Steele, Lea and Flood 2014): a bijective 64-bit mixer.
-fn splitmix64(x: u64) -> u64 {
+pub(crate) fn splitmix64(x: u64) -> u64 {
     let mut z = x.wrapping_add(0x9e37_79b9_7f4a_7c15);
     z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);

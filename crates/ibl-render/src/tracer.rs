@@ -1,21 +1,30 @@
 //! One light path per call: the radiance arriving at the camera along a primary ray, in one of
 //! the three lighting modes, through the scene with or without its virtual objects.
 //!
-//! The estimator is a unidirectional path tracer (Kajiya 1986) with next-event estimation:
-//! - **reference**: at each diffuse or glossy vertex one environment sample (importance-sampled
-//!   by texel power) and the BSDF sample that continues the path are combined by the power
-//!   heuristic (Veach 1997, multiple importance sampling); an escaping BSDF sample adds the probe's
-//!   radiance with the complementary weight. Mirrors are delta: escaping mirror rays add the probe
-//!   unweighted.
-//! - **lights**: at the first vertex every light is evaluated with its own shadow ray (no noise
-//!   from light choice); at later vertices one light is picked in proportion to its luminance.
-//!   Escaping rays add the probe only after a mirror (the lights stand for the rest of it).
-//! - **hybrid**: as lights, plus the ambient's irradiance times `albedo / pi` times the fraction
-//!   of cosine-distributed occlusion rays that escape; the path then stops at diffuse and glossy
-//!   vertices (the ambient already holds the indirect light), and continues through mirrors.
+//! - **reference**: a unidirectional path tracer (Kajiya 1986) with next-event estimation. At each
+//!   diffuse or glossy vertex one environment sample (importance-sampled by texel power) and the
+//!   BSDF sample that continues the path are combined by the power heuristic (Veach 1997, multiple
+//!   importance sampling); an escaping BSDF sample adds the probe's radiance with the
+//!   complementary weight. Mirrors are delta: escaping mirror rays add the probe unweighted. Paths
+//!   stop after `bounces` surface vertices, with Russian roulette from the fourth vertex on
+//!   (survival probability = the throughput's largest channel, at most 0.95). Unbiased: the judge
+//!   of every approximation.
+//! - **lights**: deterministic direct light. At the first diffuse or glossy vertex (after any
+//!   mirror bounces, which are followed exactly) every light is evaluated with its own shadow ray:
+//!   along its direction (hard) or towards a point of its cone drawn from one 2-D sample of the
+//!   pixel sample's stream (soft; the Sobol stream stratifies each light's cone points across the
+//!   pixel's samples). The path then ends: there is no indirect light, and no noise but the
+//!   antialiasing and soft-shadow sampling. Escaping rays add the probe only after a mirror.
+//! - **hybrid**: as lights, plus the ambient radiance `L_a` seen through `k` cosine-distributed
+//!   occlusion rays: `albedo * mean_k V(w_k) L_a(w_k)` (directional occlusion,
+//!   [`crate::lighting`]).
 //!
-//! Paths stop after `bounces` surface vertices, with Russian roulette from the fourth vertex on
-//! (survival probability = the throughput's largest channel, at most 0.95).
+//! Ray origins leave a surface by its hit point's error bound (pbrt-v4 section 6.8.6): the point
+//! moves along the geometric normal by `d = |n| . err` (`err` the per-axis bound of
+//! [`SurfacePoint::position_error`]) to the side the ray leaves on, and each coordinate is
+//! rounded one ulp further away; with the BVH's conservative `t > delta_t` test no ray can hit the
+//! surface it leaves, and the offset is set by the hit's own coordinates (about `4e-7` of their
+//! magnitude), never by the size of the scene.
 //!
 //! **Differential rendering support.** Every query first asks the real layer and then, in the
 //! pass *with* objects, the virtual layer; [`PathRecord::touched_virtual`] says whether a virtual
@@ -23,15 +32,17 @@
 //! the virtual layer took exactly the same steps as it would without it, so the caller can reuse
 //! its value for the pass without objects, bit for bit.
 //!
-//! Cost per sample: O(bounces x (1 + lights at the first vertex) x log T) ray-BVH work.
+//! Cost per sample: reference O(bounces log T) ray-BVH work; lights O(N log T) for N lights,
+//! hybrid O((N + k) log T).
 
 use glam::Vec3;
 use ibl_core::Rgb;
 use ibl_scene::{Hit, Ray, Scene, ShadowKind, SurfacePoint};
 
-use crate::lighting::{Ambient, Illumination, LightList, Lighting};
+use crate::lighting::{Ambient, DirectionalLight, Illumination, LightList, Lighting};
 use crate::material::Bsdf;
-use crate::sampling::{OrthonormalBasis, PixelRng, power_heuristic, sample_cosine_hemisphere};
+use crate::sampler::SampleStream;
+use crate::sampling::{OrthonormalBasis, power_heuristic, sample_cosine_hemisphere};
 
 /// Which layers a path may meet.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -71,8 +82,6 @@ pub struct Tracer<'a> {
     scene: &'a Scene,
     lighting: &'a Lighting,
     bounces: u32,
-    /// Offset of secondary ray origins along the geometric normal (scene-scaled).
-    epsilon: f32,
 }
 
 /// Vertex count from which Russian roulette may end a path.
@@ -86,23 +95,18 @@ struct PathState {
 }
 
 impl<'a> Tracer<'a> {
-    /// A tracer for `scene` lit by `lighting`, paths of at most `bounces` surface vertices.
+    /// A tracer for `scene` lit by `lighting`, paths of at most `bounces` surface vertices (the
+    /// lights and hybrid modes end at the first diffuse or glossy one).
     pub fn new(scene: &'a Scene, lighting: &'a Lighting, bounces: u32) -> Tracer<'a> {
-        let extent = [scene.real.bvh.bounds(), scene.virtual_objects.bvh.bounds()]
-            .into_iter()
-            .flatten()
-            .map(|(lo, hi)| lo.abs().max(hi.abs()).max_element())
-            .fold(scene.probe.position.abs().max_element(), f32::max);
         Tracer {
             scene,
             lighting,
             bounces: bounces.max(1),
-            epsilon: 1e-4 * extent.max(1.0),
         }
     }
 
-    /// Radiance along `ray` through `layers`, random numbers from `rng`.
-    pub fn trace(&self, ray: Ray, layers: Layers, rng: &mut PixelRng) -> PathRecord {
+    /// Radiance along `ray` through `layers`, random numbers from `stream`.
+    pub fn trace(&self, ray: Ray, layers: Layers, stream: &mut SampleStream) -> PathRecord {
         let mut state = PathState {
             layers,
             touched_virtual: false,
@@ -138,32 +142,41 @@ impl<'a> Tracer<'a> {
                 surface.geometric_normal,
             );
             if !bsdf.is_delta() {
-                radiance += throughput * self.direct(&surface, &bsdf, wo, vertex, rng, &mut state);
-                if matches!(self.lighting.illumination, Illumination::Hybrid(..)) {
-                    break;
-                }
-                // At the last vertex only the reference continues: its escaping BSDF sample is
-                // the MIS partner of the environment sample. The lights stand for the rest.
-                if vertex >= self.bounces
-                    && !matches!(self.lighting.illumination, Illumination::Environment)
-                {
-                    break;
+                match &self.lighting.illumination {
+                    Illumination::Environment => {
+                        radiance += throughput
+                            * self.environment_sample(&surface, &bsdf, wo, stream, &mut state);
+                    }
+                    Illumination::Lights(list) => {
+                        let direct = self.lights(list, &surface, &bsdf, wo, stream, &mut state);
+                        radiance += throughput * direct.map(|v| v.max(0.0));
+                        break;
+                    }
+                    Illumination::Hybrid(list, ambient) => {
+                        let direct = self.lights(list, &surface, &bsdf, wo, stream, &mut state)
+                            + self.ambient(ambient, &surface, stream, &mut state);
+                        radiance += throughput * direct.map(|v| v.max(0.0));
+                        break;
+                    }
                 }
             }
-            let u = [rng.next_f32(), rng.next_f32(), rng.next_f32()];
-            let Some(sample) = bsdf.sample(wo, u) else {
+            // At the last vertex the reference still draws the BSDF sample: escaping, it is the
+            // MIS partner of the environment sample.
+            let lobe = stream.next_1d();
+            let [u1, u2] = stream.next_2d();
+            let Some(sample) = bsdf.sample(wo, [lobe, u1, u2]) else {
                 break;
             };
             throughput = throughput * sample.weight;
             bsdf_pdf = (!sample.is_delta).then_some(sample.pdf_sr);
             if vertex >= ROULETTE_FROM {
                 let survive = throughput.max_channel().min(0.95);
-                if survive <= 0.0 || rng.next_f32() >= survive {
+                if survive <= 0.0 || stream.next_1d() >= survive {
                     break;
                 }
                 throughput = throughput / survive;
             }
-            ray = Ray::new(self.offset(&surface, sample.wi), sample.wi);
+            ray = Ray::new(offset_origin(&surface, sample.wi), sample.wi);
         }
         PathRecord {
             radiance,
@@ -183,28 +196,9 @@ impl<'a> Tracer<'a> {
             (Illumination::Environment, Some(pdf)) => {
                 env.radiance(direction) * power_heuristic(pdf, env.pdf(direction))
             }
-            // The lights (and the ambient) stand for the probe.
+            // The lights (and the ambient) stand for the probe; their paths end at the first
+            // diffuse or glossy vertex, so this arm is only reached by a BSDF sample there.
             (Illumination::Lights(_) | Illumination::Hybrid(..), Some(_)) => Rgb::ZERO,
-        }
-    }
-
-    /// Light arriving directly at a diffuse or glossy vertex and reflected towards `wo`.
-    fn direct(
-        &self,
-        surface: &SurfacePoint,
-        bsdf: &Bsdf,
-        wo: Vec3,
-        vertex: u32,
-        rng: &mut PixelRng,
-        state: &mut PathState,
-    ) -> Rgb {
-        match &self.lighting.illumination {
-            Illumination::Environment => self.environment_sample(surface, bsdf, wo, rng, state),
-            Illumination::Lights(list) => self.lights(list, surface, bsdf, wo, vertex, rng, state),
-            Illumination::Hybrid(list, ambient) => {
-                self.lights(list, surface, bsdf, wo, vertex, rng, state)
-                    + self.ambient(ambient, surface, rng, state)
-            }
         }
     }
 
@@ -214,11 +208,12 @@ impl<'a> Tracer<'a> {
         surface: &SurfacePoint,
         bsdf: &Bsdf,
         wo: Vec3,
-        rng: &mut PixelRng,
+        stream: &mut SampleStream,
         state: &mut PathState,
     ) -> Rgb {
         let env = &self.lighting.environment;
-        let sample = env.sample(rng.next_f32(), rng.next_f32());
+        let [u1, u2] = stream.next_2d();
+        let sample = env.sample(u1, u2);
         let wi = sample.direction;
         if sample.pdf_sr <= 0.0 {
             return Rgb::ZERO;
@@ -230,54 +225,24 @@ impl<'a> Tracer<'a> {
         f_cos * sample.radiance * (weight / sample.pdf_sr)
     }
 
-    /// Directional lights: all of them at the first vertex, one chosen by power later.
-    #[allow(clippy::too_many_arguments)]
+    /// Every light, each with its own shadow ray.
     fn lights(
         &self,
         list: &LightList,
         surface: &SurfacePoint,
         bsdf: &Bsdf,
         wo: Vec3,
-        vertex: u32,
-        rng: &mut PixelRng,
+        stream: &mut SampleStream,
         state: &mut PathState,
     ) -> Rgb {
-        if list.lights.is_empty() {
-            return Rgb::ZERO;
-        }
         let mut sum = Rgb::ZERO;
-        if vertex == 1 {
-            for light in &list.lights {
-                sum += self.one_light(list.shadows, light, surface, bsdf, wo, rng, state);
+        for light in &list.lights {
+            let wi = light_direction(list.shadows, light, stream);
+            if let Some(f_cos) = self.unblocked_reflection(surface, bsdf, wo, wi, state) {
+                sum += f_cos * light.irradiance;
             }
-        } else if let Some(choice) = list.choice.sample(rng.next_f32()) {
-            let light = &list.lights[choice.index];
-            sum += self.one_light(list.shadows, light, surface, bsdf, wo, rng, state)
-                / choice.probability;
         }
         sum
-    }
-
-    #[allow(clippy::too_many_arguments)]
-    fn one_light(
-        &self,
-        shadows: ShadowKind,
-        light: &crate::lighting::DirectionalLight,
-        surface: &SurfacePoint,
-        bsdf: &Bsdf,
-        wo: Vec3,
-        rng: &mut PixelRng,
-        state: &mut PathState,
-    ) -> Rgb {
-        let wi = match (shadows, light.cone) {
-            (ShadowKind::Soft, Some(cone)) => {
-                let local = cone.sample(rng.next_f32(), rng.next_f32());
-                OrthonormalBasis::from_normal(light.direction).to_world(local)
-            }
-            _ => light.direction,
-        };
-        self.unblocked_reflection(surface, bsdf, wo, wi, state)
-            .map_or(Rgb::ZERO, |f_cos| f_cos * light.irradiance)
     }
 
     /// `f(wo, wi) cos(theta_i)` for light arriving from `wi`, or `None` when the surface cannot
@@ -301,47 +266,28 @@ impl<'a> Tracer<'a> {
         Some(f * cos)
     }
 
-    /// The hybrid ambient: `albedo / pi * E_ambient(n) * visibility`, visibility the fraction of
-    /// cosine-distributed rays that escape.
+    /// The hybrid ambient: `albedo * mean_k V(w_k) L_a(w_k)` over cosine-distributed `w_k`.
     fn ambient(
         &self,
         ambient: &Ambient,
         surface: &SurfacePoint,
-        rng: &mut PixelRng,
+        stream: &mut SampleStream,
         state: &mut PathState,
     ) -> Rgb {
         let albedo = surface.material.diffuse_albedo();
         if albedo.max_channel() <= 0.0 {
             return Rgb::ZERO;
         }
-        let e = ambient
-            .irradiance
-            .irradiance(surface.shading_normal.as_dvec3());
-        let irradiance = Rgb::new(
-            e[0].max(0.0) as f32,
-            e[1].max(0.0) as f32,
-            e[2].max(0.0) as f32,
-        );
         let basis = OrthonormalBasis::from_normal(surface.shading_normal);
-        let mut open = 0u32;
+        let mut sum = Rgb::ZERO;
         for _ in 0..ambient.occlusion_rays {
-            let wi = basis.to_world(sample_cosine_hemisphere(rng.next_f32(), rng.next_f32()));
+            let [u1, u2] = stream.next_2d();
+            let wi = basis.to_world(sample_cosine_hemisphere(u1, u2));
             if surface.geometric_normal.dot(wi) > 0.0 && !self.occluded(surface, wi, state) {
-                open += 1;
+                sum += ambient.radiance(wi);
             }
         }
-        let visibility = open as f32 / ambient.occlusion_rays as f32;
-        albedo * irradiance * (visibility / std::f32::consts::PI)
-    }
-
-    /// The origin of a ray leaving `surface` along `wi`, moved off the surface on `wi`'s side.
-    fn offset(&self, surface: &SurfacePoint, wi: Vec3) -> Vec3 {
-        let side = if surface.geometric_normal.dot(wi) >= 0.0 {
-            1.0
-        } else {
-            -1.0
-        };
-        surface.position + surface.geometric_normal * (side * self.epsilon)
+        albedo * sum / ambient.occlusion_rays as f32
     }
 
     /// Closest hit through the active layers; `true` when it is virtual.
@@ -352,28 +298,21 @@ impl<'a> Tracer<'a> {
             let limit = real.map_or(f32::INFINITY, |h: Hit| h.t);
             if let Some(hit) = self.scene.virtual_objects.bvh.closest_hit(ray, 0.0, limit) {
                 state.touched_virtual = true;
-                let surface =
-                    self.scene
-                        .virtual_objects
-                        .surface_point(&hit, ray.origin, ray.direction);
+                let surface = self
+                    .scene
+                    .virtual_objects
+                    .surface_point(&hit, ray.direction);
                 return Some((surface, true));
             }
         }
-        real.map(|hit| {
-            (
-                self.scene
-                    .real
-                    .surface_point(&hit, ray.origin, ray.direction),
-                false,
-            )
-        })
+        real.map(|hit| (self.scene.real.surface_point(&hit, ray.direction), false))
     }
 
     /// Whether anything blocks the direction `wi` from `surface` (to infinity: the lights and
     /// the environment are distant).
     fn occluded(&self, surface: &SurfacePoint, wi: Vec3, state: &mut PathState) -> bool {
         state.rays += 1;
-        let ray = Ray::new(self.offset(surface, wi), wi);
+        let ray = Ray::new(offset_origin(surface, wi), wi);
         if self.scene.real.bvh.occluded(&ray, 0.0, f32::INFINITY) {
             return true;
         }
@@ -389,4 +328,48 @@ impl<'a> Tracer<'a> {
         }
         false
     }
+}
+
+/// The direction a light's shadow ray takes: its own (hard, or a point light) or a point of its
+/// cone from the stream's next pair (soft).
+fn light_direction(
+    shadows: ShadowKind,
+    light: &DirectionalLight,
+    stream: &mut SampleStream,
+) -> Vec3 {
+    match (shadows, light.cone) {
+        (ShadowKind::Soft, Some(cone)) => {
+            let [u1, u2] = stream.next_2d();
+            OrthonormalBasis::from_normal(light.direction).to_world(cone.sample(u1, u2))
+        }
+        _ => light.direction,
+    }
+}
+
+/// The origin of a ray leaving `surface` along `wi`: the hit point moved along the geometric
+/// normal, to `wi`'s side, by `|n| . err`, then every coordinate rounded one ulp away from the
+/// surface (pbrt-v4 `OffsetRayOrigin`, section 6.8.6).
+pub fn offset_origin(surface: &SurfacePoint, wi: Vec3) -> Vec3 {
+    let n = surface.geometric_normal;
+    let distance = n.abs().dot(surface.position_error);
+    let offset = if n.dot(wi) >= 0.0 {
+        n * distance
+    } else {
+        n * -distance
+    };
+    let p = surface.position + offset;
+    let away = |p: f32, o: f32| {
+        if o > 0.0 {
+            p.next_up()
+        } else if o < 0.0 {
+            p.next_down()
+        } else {
+            p
+        }
+    };
+    Vec3::new(
+        away(p.x, offset.x),
+        away(p.y, offset.y),
+        away(p.z, offset.z),
+    )
 }

@@ -21,7 +21,7 @@ use glam::DVec3;
 use ibl_core::{Image, Rgb};
 use ibl_extract::{Light, LightSet};
 use ibl_render::lighting::LightingPlan;
-use ibl_render::{Lighting, RenderOutput, RenderSettings, render};
+use ibl_render::{Lighting, RenderOutput, RenderSettings, SamplerKind, render};
 use ibl_scene::description::CompositeRule;
 use ibl_scene::{RenderMode, Scene, SceneDescription, ShadowKind};
 
@@ -64,6 +64,7 @@ fn settings(spp: u32, bounces: u32, seed: u64, composite: CompositeRule) -> Rend
         spp,
         bounces,
         seed,
+        sampler: SamplerKind::Sobol,
     }
 }
 

@@ -41,7 +41,7 @@
 use glam::DVec3;
 use ibl_core::{Image, LatLong, Rgb};
 use ibl_render::lighting::LightingPlan;
-use ibl_render::{Lighting, RenderOutput, RenderSettings, render};
+use ibl_render::{Lighting, RenderOutput, RenderSettings, SamplerKind, render};
 use ibl_scene::description::CompositeRule;
 use ibl_scene::{RenderMode, Scene, SceneDescription, ShadowKind};
 
@@ -213,6 +213,7 @@ fn settings(spp: u32, seed: u64) -> RenderSettings {
         spp,
         bounces: 1,
         seed,
+        sampler: SamplerKind::Sobol,
     }
 }
 

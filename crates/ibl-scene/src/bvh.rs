@@ -37,7 +37,11 @@
 //! they share a sign (either sign: both faces), `t = (U A_z + V B_z + W C_z) / (U + V + W)`.
 //! Neighbours compute their shared edge function from the same floats, so a ray through a shared
 //! edge or corner always hits at least one of them. The dominant axis is a const generic: one
-//! branch per ray, none per triangle.
+//! branch per ray, none per triangle. A hit is reported only when `t` exceeds its own
+//! conservative rounding-error bound `delta_t` (Pharr, Jakob and Humphreys, *Physically Based
+//! Rendering*, 4th ed., section 6.8.4): a ray leaving a surface from an origin offset by that
+//! surface's hit-point error bound can then never hit the surface again, however large the
+//! triangle, and `t_min = 0` is the right lower limit for such rays.
 //!
 //! **Traversal**: near child first with an explicit 64-entry stack (no allocation per query);
 //! popped subtrees farther than the best hit are skipped. Closest-hit ties (equal `t`) go to the
@@ -46,7 +50,7 @@
 
 use glam::{Vec3, Vec3A, Vec4, Vec4Swizzles};
 
-use crate::ray::{Hit, Ray};
+use crate::ray::{Hit, Ray, gamma};
 
 /// Centroid bins per axis in the SAH sweep.
 const BINS: usize = 16;
@@ -696,7 +700,8 @@ impl<const KX: usize, const KY: usize, const KZ: usize> TriangleRay<KX, KY, KZ> 
         }
     }
 
-    /// The two-sided watertight test; `None` on a miss, otherwise `t` along the ray (any sign).
+    /// The two-sided watertight test; `None` on a miss or when `t` is not certainly positive
+    /// (at most its rounding-error bound), otherwise `t` along the ray.
     #[inline(always)]
     fn intersect(&self, tri: &[f32; 9]) -> Option<TriangleHit> {
         let o = &self.origin;
@@ -729,6 +734,23 @@ impl<const KX: usize, const KY: usize, const KZ: usize> TriangleRay<KX, KY, KZ> 
             return None;
         }
         let t = sz * (u * az + v * bz + w * cz) / det;
+        // Only hits certainly in front of the origin: `t` above its own rounding-error bound
+        // (pbrt-v4 section 6.8.4, in this test's variables, with the shear terms weighted by the
+        // shear factors, which pbrt bounds by 1).
+        let max_z = az.abs().max(bz.abs()).max(cz.abs());
+        let max_zt = sz.abs() * max_z;
+        let max_x = ax.abs().max(bx.abs()).max(cx.abs());
+        let max_y = ay.abs().max(by.abs()).max(cy.abs());
+        let delta_x = gamma(5) * (max_x + sx.abs() * max_z);
+        let delta_y = gamma(5) * (max_y + sy.abs() * max_z);
+        let delta_e = 2.0 * (gamma(2) * max_x * max_y + delta_y * max_x + delta_x * max_y);
+        let max_e = u.abs().max(v.abs()).max(w.abs());
+        let delta_t = 3.0
+            * (gamma(3) * max_e * max_zt + delta_e * max_zt + gamma(3) * max_zt * max_e)
+            / det.abs();
+        if !(t > delta_t) {
+            return None;
+        }
         Some(TriangleHit { t, v, w, det })
     }
 }

@@ -245,6 +245,31 @@ pub struct RenderDescription {
     /// How the objects' effect on real surfaces is composited. Default `difference`.
     #[serde(default)]
     pub composite: CompositeRule,
+    /// Which random numbers the samples draw. Default `sobol`.
+    #[serde(default)]
+    pub sampler: SamplerKind,
+}
+
+/// Which random numbers a render's samples draw (every mode).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SamplerKind {
+    /// Owen-scrambled Sobol points (low discrepancy): each pair of numbers a sample draws is
+    /// stratified across the pixel's samples.
+    #[default]
+    Sobol,
+    /// Independent uniform numbers (PCG32).
+    Independent,
+}
+
+impl SamplerKind {
+    /// The name used in files and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            SamplerKind::Sobol => "sobol",
+            SamplerKind::Independent => "independent",
+        }
+    }
 }
 
 /// How differential rendering adds the objects' effect on real surfaces to the background `B`.
@@ -290,6 +315,7 @@ impl Default for RenderDescription {
             bounces: default_bounces(),
             seed: default_seed(),
             composite: CompositeRule::default(),
+            sampler: SamplerKind::default(),
         }
     }
 }
@@ -330,9 +356,13 @@ pub struct LightingDescription {
     pub lights: u32,
     /// A light file (`ibl lights` JSON) to use instead of extracting, relative to the scene file.
     pub lights_file: Option<PathBuf>,
-    /// `hard` or `soft` (each light a cone of its own solid angle). Default `hard`.
+    /// `hard` or `soft` (each light a cone of its own solid angle). Default `soft`.
     #[serde(default)]
     pub shadows: ShadowKind,
+    /// Samples per pixel of the `lights` and `hybrid` modes (antialiasing; each sample evaluates
+    /// every light once, its soft-shadow cone stratified across the samples). Default 8.
+    #[serde(default = "default_lights_spp")]
+    pub spp: u32,
     /// SH bands of the hybrid ambient. Default 3.
     #[serde(default = "default_bands")]
     pub ambient_bands: u32,
@@ -346,6 +376,9 @@ fn default_method() -> String {
 }
 fn default_lights() -> u32 {
     16
+}
+fn default_lights_spp() -> u32 {
+    8
 }
 fn default_bands() -> u32 {
     3
@@ -361,6 +394,7 @@ impl Default for LightingDescription {
             lights: default_lights(),
             lights_file: None,
             shadows: ShadowKind::default(),
+            spp: default_lights_spp(),
             ambient_bands: default_bands(),
             ao_samples: default_ao(),
         }
@@ -372,9 +406,9 @@ impl Default for LightingDescription {
 #[serde(rename_all = "lowercase")]
 pub enum ShadowKind {
     /// One shadow ray towards each light's direction.
-    #[default]
     Hard,
     /// Shadow rays spread over a cone of the light's own solid angle.
+    #[default]
     Soft,
 }
 
@@ -498,6 +532,12 @@ impl SceneDescription {
             return Err(invalid(
                 "lighting.lights",
                 format!("{} is not in 1..=4096", l.lights),
+            ));
+        }
+        if !(1..=MAX_SPP).contains(&l.spp) {
+            return Err(invalid(
+                "lighting.spp",
+                format!("{} is not in 1..={MAX_SPP}", l.spp),
             ));
         }
         if !(1..=16).contains(&l.ambient_bands) {
