@@ -52,21 +52,24 @@ impl SobolStream {
         }
     }
 
-    /// The next pair: point `index` of the pair's scrambled (0,2)-sequence.
-    pub fn next_2d(&mut self) -> [f32; 2] {
-        let seed = splitmix64(self.pixel_key ^ splitmix64(self.pair)) as u32;
+    /// The seed of the next pair.
+    fn next_seed(&mut self) -> u32 {
+        let seed = splitmix64(self.pixel_key ^ self.pair.wrapping_mul(0x9e37_79b9_7f4a_7c15));
         self.pair += 1;
-        [
-            sobol_burley::sample(self.index, 0, seed),
-            sobol_burley::sample(self.index, 1, seed),
-        ]
+        seed as u32
+    }
+
+    /// The next pair: point `index` of the pair's scrambled (0,2)-sequence. (Dimensions 0 to 3
+    /// come from one SIMD evaluation, as fast as one scalar dimension; 2 and 3 are unused: their
+    /// 2-D projection is not a (0,2)-sequence.)
+    pub fn next_2d(&mut self) -> [f32; 2] {
+        let [a, b, _, _] = sobol_burley::sample_4d(self.index, 0, self.next_seed());
+        [a, b]
     }
 
     /// The next number: the first coordinate of a fresh pair.
     pub fn next_1d(&mut self) -> f32 {
-        let seed = splitmix64(self.pixel_key ^ splitmix64(self.pair)) as u32;
-        self.pair += 1;
-        sobol_burley::sample(self.index, 0, seed)
+        sobol_burley::sample(self.index, 0, self.next_seed())
     }
 }
 

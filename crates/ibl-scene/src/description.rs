@@ -360,13 +360,13 @@ pub struct LightingDescription {
     #[serde(default)]
     pub shadows: ShadowKind,
     /// Samples per pixel of the `lights` and `hybrid` modes (antialiasing; each sample evaluates
-    /// every light once, its soft-shadow cone stratified across the samples). Default 8.
+    /// every light once, its soft-shadow cone stratified across the samples). Default 4.
     #[serde(default = "default_lights_spp")]
     pub spp: u32,
     /// SH bands of the hybrid ambient. Default 3.
     #[serde(default = "default_bands")]
     pub ambient_bands: u32,
-    /// Ambient-occlusion rays per shading point (hybrid). Default 16.
+    /// Occlusion rays per shading point and sample (hybrid). Default 4.
     #[serde(default = "default_ao")]
     pub ao_samples: u32,
 }
@@ -378,13 +378,13 @@ fn default_lights() -> u32 {
     16
 }
 fn default_lights_spp() -> u32 {
-    8
+    4
 }
 fn default_bands() -> u32 {
     3
 }
 fn default_ao() -> u32 {
-    16
+    4
 }
 
 impl Default for LightingDescription {
