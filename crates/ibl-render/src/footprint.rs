@@ -145,7 +145,7 @@ impl<'a> PixelFootprint<'a> {
             return self.texel(s.floor() as i64, t.floor() as i64);
         }
         let total = area(&corners);
-        if !(total > 0.0) {
+        if total.is_nan() || total <= 0.0 {
             return self.texel(s0.floor() as i64, coords[0].1.floor() as i64);
         }
         // The parallels' chords may bulge a little past the corners' range: one texel of margin.

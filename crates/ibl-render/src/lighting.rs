@@ -192,8 +192,8 @@ fn with_cones_spread(ambient: &RadianceSh, lights: &LightSet) -> RadianceSh {
         }
         let factors = cap_zonal_factors((a / TAU).min(2.0), bands);
         let y = basis(light.dir(), bands);
-        for l in 0..bands {
-            let spread = 1.0 - factors[l];
+        for (l, g) in factors.iter().enumerate() {
+            let spread = 1.0 - g;
             for k in l * l..(l + 1) * (l + 1) {
                 for (v, power) in coefficients[k].iter_mut().zip(light.irradiance) {
                     *v += power * spread * y[k];

@@ -748,10 +748,8 @@ impl<const KX: usize, const KY: usize, const KZ: usize> TriangleRay<KX, KY, KZ> 
         let delta_t = 3.0
             * (gamma(3) * max_e * max_zt + delta_e * max_zt + gamma(3) * max_zt * max_e)
             / det.abs();
-        if !(t > delta_t) {
-            return None;
-        }
-        Some(TriangleHit { t, v, w, det })
+        // NaN `t` (a degenerate triangle) is no hit either.
+        (t > delta_t).then_some(TriangleHit { t, v, w, det })
     }
 }
 
