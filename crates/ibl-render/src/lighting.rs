@@ -40,7 +40,7 @@ use ibl_scene::{Scene, ShadowKind};
 use ibl_sh::{RadianceSh, basis, eval_basis};
 
 use crate::environment::{EnvironmentError, EnvironmentLight};
-use crate::sampling::UniformCone;
+use crate::sampling::{OrthonormalBasis, UniformCone};
 
 /// One directional light, world frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -51,6 +51,8 @@ pub struct DirectionalLight {
     pub irradiance: Rgb,
     /// The cone of the light's solid angle (soft shadows), `None` for a point-like light.
     pub cone: Option<UniformCone>,
+    /// The basis about `direction` in which the cone is sampled.
+    pub frame: OrthonormalBasis,
 }
 
 /// The directional part of the `lights` and `hybrid` modes.
@@ -239,14 +241,18 @@ fn light_list(scene: &Scene, set: &LightSet, shadows: ShadowKind) -> LightList {
         .lights
         .iter()
         .filter(|l| l.irradiance.iter().any(|&c| c > 0.0))
-        .map(|l| DirectionalLight {
-            direction: (rotation * l.dir()).normalize_or(DVec3::Y).as_vec3(),
-            irradiance: Rgb::new(
-                l.irradiance[0] as f32,
-                l.irradiance[1] as f32,
-                l.irradiance[2] as f32,
-            ),
-            cone: UniformCone::from_solid_angle(l.solid_angle_sr as f32),
+        .map(|l| {
+            let direction = (rotation * l.dir()).normalize_or(DVec3::Y).as_vec3();
+            DirectionalLight {
+                direction,
+                irradiance: Rgb::new(
+                    l.irradiance[0] as f32,
+                    l.irradiance[1] as f32,
+                    l.irradiance[2] as f32,
+                ),
+                cone: UniformCone::from_solid_angle(l.solid_angle_sr as f32),
+                frame: OrthonormalBasis::from_normal(direction),
+            }
         })
         .collect();
     LightList { lights, shadows }

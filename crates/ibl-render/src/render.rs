@@ -291,13 +291,21 @@ fn pixel(
             PrimaryHit::Real => {
                 sums.with += with.radiance;
                 if with.touched_virtual {
-                    let without = tracer.trace(ray, Layers::RealOnly, &mut after_jitter(s));
-                    sums.without += without.radiance;
-                    sums.difference += with.radiance - without.radiance;
+                    // The lights and hybrid modes usually evaluated the path without the objects
+                    // in the same walk; otherwise it is walked again through the real layer.
+                    let without = match with.without_objects {
+                        Some(radiance) => radiance,
+                        None => {
+                            let again = tracer.trace(ray, Layers::RealOnly, &mut after_jitter(s));
+                            sums.rays += again.rays;
+                            sums.paths_without += 1;
+                            again.radiance
+                        }
+                    };
+                    sums.without += without;
+                    sums.difference += with.radiance - without;
                     sums.real_with += with.radiance;
-                    sums.real_without += without.radiance;
-                    sums.rays += without.rays;
-                    sums.paths_without += 1;
+                    sums.real_without += without;
                 } else {
                     sums.without += with.radiance;
                     sums.real_with += with.radiance;

@@ -30,7 +30,14 @@
 //! pass *with* objects, the virtual layer; [`PathRecord::touched_virtual`] says whether a virtual
 //! triangle changed any answer (closer hit, or a blocked shadow ray). A path that never touched
 //! the virtual layer took exactly the same steps as it would without it, so the caller can reuse
-//! its value for the pass without objects, bit for bit.
+//! its value for the pass without objects, bit for bit. In the lights and hybrid modes a path
+//! that reaches its one diffuse or glossy vertex without a virtual closest hit also evaluates
+//! that vertex without the objects in the same walk ([`PathRecord::without_objects`]): each
+//! shadow and occlusion ray is open, blocked by the real layer (dark in both) or blocked by the
+//! virtual layer only (dark with the objects), so one set of rays gives both values, bit for bit
+//! what a second walk through the real layer alone would give (the same random numbers, the same
+//! sums in the same order). Only a path whose closest hit changed (the camera sees the object, or
+//! a mirror reflects it) is walked again.
 //!
 //! Cost per sample: reference O(bounces log T) ray-BVH work; lights O(N log T) for N lights,
 //! hybrid O((N + k) log T).
@@ -75,6 +82,72 @@ pub struct PathRecord {
     pub touched_virtual: bool,
     /// Rays traced (closest-hit and shadow queries).
     pub rays: u64,
+    /// The radiance of the same path without the objects, when this walk could tell it (the
+    /// lights and hybrid modes, for a path through [`Layers::WithObjects`] that met no virtual
+    /// surface): then no second walk is needed, even when [`PathRecord::touched_virtual`].
+    pub without_objects: Option<Rgb>,
+}
+
+/// Whether a ray towards a distant light is blocked, and by which layer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Occlusion {
+    /// Nothing blocks it.
+    Open,
+    /// The virtual objects block it, the real layer does not.
+    Virtual,
+    /// The real layer blocks it (with or without the objects).
+    Real,
+}
+
+/// A diffuse or glossy vertex being shaded.
+struct Vertex<'a> {
+    surface: &'a SurfacePoint,
+    bsdf: &'a Bsdf,
+    /// Unit direction towards the camera (the previous vertex).
+    wo: Vec3,
+}
+
+/// Light arriving at a vertex, with the objects and (when the walk can tell) without them.
+#[derive(Clone, Copy, Debug)]
+struct LayeredLight {
+    with: Rgb,
+    without: Option<Rgb>,
+}
+
+impl LayeredLight {
+    /// No light yet, in the layers a walk in `state` can evaluate at its vertex: without the
+    /// objects too while it goes through both layers and no virtual triangle has changed any of
+    /// its queries so far (decided once per vertex, before its shadow rays).
+    fn none(state: &PathState) -> LayeredLight {
+        LayeredLight {
+            with: Rgb::ZERO,
+            without: (state.layers == Layers::WithObjects && !state.touched_virtual)
+                .then_some(Rgb::ZERO),
+        }
+    }
+
+    /// Adds `value` to the layers in which a ray blocked as `occlusion` is open.
+    #[inline]
+    fn add(&mut self, occlusion: Occlusion, value: Rgb) {
+        if occlusion == Occlusion::Open {
+            self.with += value;
+        }
+        if let Some(without) = &mut self.without
+            && occlusion != Occlusion::Real
+        {
+            *without += value;
+        }
+    }
+}
+
+impl std::ops::Add for LayeredLight {
+    type Output = LayeredLight;
+    fn add(self, other: LayeredLight) -> LayeredLight {
+        LayeredLight {
+            with: self.with + other.with,
+            without: self.without.zip(other.without).map(|(a, b)| a + b),
+        }
+    }
 }
 
 /// Traces paths through one scene under one lighting.
@@ -119,6 +192,7 @@ impl<'a> Tracer<'a> {
         // Density of the BSDF sample that made `ray` (None: camera ray or mirror).
         let mut bsdf_pdf: Option<f32> = None;
         let mut vertex = 0u32;
+        let mut without_objects = None;
         loop {
             let Some((surface, is_virtual)) = self.closest(&ray, &mut state) else {
                 radiance += throughput * self.escaped(ray.direction, bsdf_pdf);
@@ -148,14 +222,32 @@ impl<'a> Tracer<'a> {
                             * self.environment_sample(&surface, &bsdf, wo, stream, &mut state);
                     }
                     Illumination::Lights(list) => {
-                        let direct = self.lights(list, &surface, &bsdf, wo, stream, &mut state);
-                        radiance += throughput * direct.map(|v| v.max(0.0));
+                        let none = LayeredLight::none(&state);
+                        let vertex = Vertex {
+                            surface: &surface,
+                            bsdf: &bsdf,
+                            wo,
+                        };
+                        let direct = self.lights(list, &vertex, stream, &mut state, none);
+                        without_objects = direct
+                            .without
+                            .map(|w| radiance + throughput * w.map(|v| v.max(0.0)));
+                        radiance += throughput * direct.with.map(|v| v.max(0.0));
                         break;
                     }
                     Illumination::Hybrid(list, ambient) => {
-                        let direct = self.lights(list, &surface, &bsdf, wo, stream, &mut state)
-                            + self.ambient(ambient, &surface, stream, &mut state);
-                        radiance += throughput * direct.map(|v| v.max(0.0));
+                        let none = LayeredLight::none(&state);
+                        let vertex = Vertex {
+                            surface: &surface,
+                            bsdf: &bsdf,
+                            wo,
+                        };
+                        let direct = self.lights(list, &vertex, stream, &mut state, none)
+                            + self.ambient(ambient, &surface, stream, &mut state, none);
+                        without_objects = direct
+                            .without
+                            .map(|w| radiance + throughput * w.map(|v| v.max(0.0)));
+                        radiance += throughput * direct.with.map(|v| v.max(0.0));
                         break;
                     }
                 }
@@ -183,6 +275,7 @@ impl<'a> Tracer<'a> {
             primary,
             touched_virtual: state.touched_virtual,
             rays: state.rays,
+            without_objects,
         }
     }
 
@@ -218,52 +311,37 @@ impl<'a> Tracer<'a> {
         if sample.pdf_sr <= 0.0 {
             return Rgb::ZERO;
         }
-        let Some(f_cos) = self.unblocked_reflection(surface, bsdf, wo, wi, state) else {
+        let Some(f_cos) = reflection(surface, bsdf, wo, wi) else {
             return Rgb::ZERO;
         };
+        if self.occlusion(above(surface), wi, state) != Occlusion::Open {
+            return Rgb::ZERO;
+        }
         let weight = power_heuristic(sample.pdf_sr, bsdf.pdf(wo, wi));
         f_cos * sample.radiance * (weight / sample.pdf_sr)
     }
 
-    /// Every light, each with its own shadow ray.
+    /// Every light, each with its own shadow ray (all from one origin above the surface: a
+    /// light below the geometric surface sends none).
     fn lights(
         &self,
         list: &LightList,
-        surface: &SurfacePoint,
-        bsdf: &Bsdf,
-        wo: Vec3,
+        vertex: &Vertex,
         stream: &mut SampleStream,
         state: &mut PathState,
-    ) -> Rgb {
-        let mut sum = Rgb::ZERO;
+        mut sum: LayeredLight,
+    ) -> LayeredLight {
+        let origin = above(vertex.surface);
         for light in &list.lights {
             let wi = light_direction(list.shadows, light, stream);
-            if let Some(f_cos) = self.unblocked_reflection(surface, bsdf, wo, wi, state) {
-                sum += f_cos * light.irradiance;
+            if let Some(f_cos) = reflection(vertex.surface, vertex.bsdf, vertex.wo, wi) {
+                sum.add(
+                    self.occlusion(origin, wi, state),
+                    f_cos * light.irradiance,
+                );
             }
         }
         sum
-    }
-
-    /// `f(wo, wi) cos(theta_i)` for light arriving from `wi`, or `None` when the surface cannot
-    /// reflect it (below the shading or geometric surface, a zero BSDF) or something blocks it.
-    fn unblocked_reflection(
-        &self,
-        surface: &SurfacePoint,
-        bsdf: &Bsdf,
-        wo: Vec3,
-        wi: Vec3,
-        state: &mut PathState,
-    ) -> Option<Rgb> {
-        let cos = surface.shading_normal.dot(wi);
-        if cos <= 0.0 || surface.geometric_normal.dot(wi) <= 0.0 {
-            return None;
-        }
-        let f = bsdf.eval(wo, wi);
-        if f.max_channel() <= 0.0 || self.occluded(surface, wi, state) {
-            return None;
-        }
-        Some(f * cos)
     }
 
     /// The hybrid ambient: `albedo * mean_k V(w_k) L_a(w_k)` over cosine-distributed `w_k`.
@@ -273,21 +351,26 @@ impl<'a> Tracer<'a> {
         surface: &SurfacePoint,
         stream: &mut SampleStream,
         state: &mut PathState,
-    ) -> Rgb {
+        mut sum: LayeredLight,
+    ) -> LayeredLight {
         let albedo = surface.material.diffuse_albedo();
         if albedo.max_channel() <= 0.0 {
-            return Rgb::ZERO;
+            return sum;
         }
         let basis = OrthonormalBasis::from_normal(surface.shading_normal);
-        let mut sum = Rgb::ZERO;
+        let origin = above(surface);
         for _ in 0..ambient.occlusion_rays {
             let [u1, u2] = stream.next_2d();
             let wi = basis.to_world(sample_cosine_hemisphere(u1, u2));
-            if surface.geometric_normal.dot(wi) > 0.0 && !self.occluded(surface, wi, state) {
-                sum += ambient.radiance(wi);
+            if surface.geometric_normal.dot(wi) > 0.0 {
+                sum.add(self.occlusion(origin, wi, state), ambient.radiance(wi));
             }
         }
-        albedo * sum / ambient.occlusion_rays as f32
+        let scale = |sum: Rgb| albedo * sum / ambient.occlusion_rays as f32;
+        LayeredLight {
+            with: scale(sum.with),
+            without: sum.without.map(scale),
+        }
     }
 
     /// Closest hit through the active layers; `true` when it is virtual.
@@ -308,13 +391,13 @@ impl<'a> Tracer<'a> {
         real.map(|hit| (self.scene.real.surface_point(&hit, ray.direction), false))
     }
 
-    /// Whether anything blocks the direction `wi` from `surface` (to infinity: the lights and
-    /// the environment are distant).
-    fn occluded(&self, surface: &SurfacePoint, wi: Vec3, state: &mut PathState) -> bool {
+    /// What blocks the direction `wi` from `origin` (a point just above a surface, [`above`]),
+    /// to infinity: the lights and the environment are distant.
+    fn occlusion(&self, origin: Vec3, wi: Vec3, state: &mut PathState) -> Occlusion {
         state.rays += 1;
-        let ray = Ray::new(offset_origin(surface, wi), wi);
+        let ray = Ray::new(origin, wi);
         if self.scene.real.bvh.occluded(&ray, 0.0, f32::INFINITY) {
-            return true;
+            return Occlusion::Real;
         }
         if state.layers == Layers::WithObjects
             && self
@@ -324,10 +407,28 @@ impl<'a> Tracer<'a> {
                 .occluded(&ray, 0.0, f32::INFINITY)
         {
             state.touched_virtual = true;
-            return true;
+            return Occlusion::Virtual;
         }
-        false
+        Occlusion::Open
     }
+}
+
+/// `f(wo, wi) cos(theta_i)` for light arriving from `wi`, or `None` when the surface cannot
+/// reflect it (below the shading or geometric surface, or a zero BSDF).
+#[inline]
+fn reflection(surface: &SurfacePoint, bsdf: &Bsdf, wo: Vec3, wi: Vec3) -> Option<Rgb> {
+    let cos = surface.shading_normal.dot(wi);
+    if cos <= 0.0 || surface.geometric_normal.dot(wi) <= 0.0 {
+        return None;
+    }
+    let f = bsdf.eval(wo, wi);
+    (f.max_channel() > 0.0).then(|| f * cos)
+}
+
+/// The origin of every ray that leaves `surface` on its geometric normal's side (shadow and
+/// occlusion rays, which are only traced there): [`offset_origin`] along that normal.
+fn above(surface: &SurfacePoint) -> Vec3 {
+    offset_origin(surface, surface.geometric_normal)
 }
 
 /// The direction a light's shadow ray takes: its own (hard, or a point light) or a point of its
@@ -340,7 +441,7 @@ fn light_direction(
     match (shadows, light.cone) {
         (ShadowKind::Soft, Some(cone)) => {
             let [u1, u2] = stream.next_2d();
-            OrthonormalBasis::from_normal(light.direction).to_world(cone.sample(u1, u2))
+            light.frame.to_world(cone.sample(u1, u2))
         }
         _ => light.direction,
     }

@@ -376,12 +376,29 @@ impl Bvh {
         t_min: f32,
         t_max: f32,
     ) -> bool {
-        let tri_ray = TriangleRay::<KX, KY, KZ>::new(ray);
         let box_ray = BoxRay::new(ray, t_min);
         let cull = widen(t_max);
+        let mut node = self.root;
+        // Early outs before the triangle ray and the traversal stack (zeroed, 512 bytes) are
+        // made: most shadow rays miss both of the root's children (the rays from a floor past a
+        // small object), and a root leaf (a ground plane's two triangles) is tested directly.
+        if node.count == 0 && box_ray.test(&self.pairs[node.child as usize], cull).0 == 0 {
+            return false;
+        }
+        let tri_ray = TriangleRay::<KX, KY, KZ>::new(ray);
+        let hits = |tri: &[f32; 9]| {
+            tri_ray
+                .intersect(tri)
+                .is_some_and(|h| h.t > t_min && h.t < t_max)
+        };
+        if node.count > 0 {
+            let first = node.child as usize;
+            return self.triangles[first..first + node.count as usize]
+                .iter()
+                .any(hits);
+        }
         let mut stack = [NodeRef::default(); STACK_SIZE];
         let mut sp = 0;
-        let mut node = self.root;
         loop {
             if node.count == 0 {
                 let pair = &self.pairs[node.child as usize];
@@ -405,13 +422,11 @@ impl Bvh {
                 continue;
             }
             let first = node.child as usize;
-            for tri in &self.triangles[first..first + node.count as usize] {
-                if let Some(h) = tri_ray.intersect(tri)
-                    && h.t > t_min
-                    && h.t < t_max
-                {
-                    return true;
-                }
+            if self.triangles[first..first + node.count as usize]
+                .iter()
+                .any(hits)
+            {
+                return true;
             }
             if sp == 0 {
                 return false;
@@ -734,6 +749,10 @@ impl<const KX: usize, const KY: usize, const KZ: usize> TriangleRay<KX, KY, KZ> 
             return None;
         }
         let t = sz * (u * az + v * bz + w * cz) / det;
+        // Behind the origin (a shadow ray's own surface, most often): no hit whatever the bound.
+        if t <= 0.0 || t.is_nan() {
+            return None;
+        }
         // Only hits certainly in front of the origin: `t` above its own rounding-error bound
         // (pbrt-v4 section 6.8.4, in this test's variables, with the shear terms weighted by the
         // shear factors, which pbrt bounds by 1).
