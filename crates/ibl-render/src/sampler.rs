@@ -189,7 +189,10 @@ mod tests {
     fn pairs_are_bit_for_bit_those_of_sobol_burley() {
         let seeds = [0u32, 1, 2, 0xdead_beef, u32::MAX, 0x1234_5678];
         for &seed in &seeds {
-            for index in (0..SOBOL_MAX_SAMPLES).step_by(7).chain([SOBOL_MAX_SAMPLES - 1]) {
+            for index in (0..SOBOL_MAX_SAMPLES)
+                .step_by(7)
+                .chain([SOBOL_MAX_SAMPLES - 1])
+            {
                 let rev = shuffled_rev_index(index.reverse_bits(), seed);
                 let base = seed.wrapping_mul(SEED_MULTIPLIER);
                 let pair = [

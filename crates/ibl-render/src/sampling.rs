@@ -128,9 +128,8 @@ impl OrthonormalBasis {
 #[inline]
 fn cos_sin_octant(alpha: f32) -> (f32, f32) {
     let a2 = alpha * alpha;
-    let cos = 1.0
-        + a2 * (-1.0 / 2.0
-            + a2 * (1.0 / 24.0 + a2 * (-1.0 / 720.0 + a2 * (1.0 / 40_320.0))));
+    let cos =
+        1.0 + a2 * (-1.0 / 2.0 + a2 * (1.0 / 24.0 + a2 * (-1.0 / 720.0 + a2 * (1.0 / 40_320.0))));
     let sin = alpha
         * (1.0
             + a2 * (-1.0 / 6.0

@@ -335,10 +335,7 @@ impl<'a> Tracer<'a> {
         for light in &list.lights {
             let wi = light_direction(list.shadows, light, stream);
             if let Some(f_cos) = reflection(vertex.surface, vertex.bsdf, vertex.wo, wi) {
-                sum.add(
-                    self.occlusion(origin, wi, state),
-                    f_cos * light.irradiance,
-                );
+                sum.add(self.occlusion(origin, wi, state), f_cos * light.irradiance);
             }
         }
         sum
