@@ -35,7 +35,7 @@ use std::f64::consts::TAU;
 
 use glam::{DMat3, DVec3, Vec3};
 use ibl_core::Rgb;
-use ibl_extract::{Hybrid, LightSet};
+use ibl_light::LightSet;
 use ibl_scene::{Scene, ShadowKind};
 use ibl_sh::{RadianceSh, basis, eval_basis};
 
@@ -158,24 +158,25 @@ impl Lighting {
         })
     }
 
-    /// `hybrid` mode: `hybrid` (lights + SH ambient, its ambient the probe minus the lights as
-    /// point sources) is in the probe's frame; with soft shadows the ambient gives back what the
-    /// cones spread (see the module notes).
+    /// `hybrid` mode: the lights `set` and the `ambient` radiance (the probe minus the lights as
+    /// point sources, as `ibl_extract::Hybrid` makes it) are in the probe's frame; with soft
+    /// shadows the ambient gives back what the cones spread (see the module notes).
     pub fn hybrid(
         scene: &Scene,
-        hybrid: &Hybrid,
+        set: &LightSet,
+        ambient: &RadianceSh,
         shadows: ShadowKind,
         occlusion_rays: u32,
     ) -> Result<Lighting, EnvironmentError> {
         let rotation = scene.probe.world_from_probe.as_dmat3();
         let ambient = match shadows {
-            ShadowKind::Hard => hybrid.ambient.clone(),
-            ShadowKind::Soft => with_cones_spread(&hybrid.ambient, &hybrid.lights),
+            ShadowKind::Hard => ambient.clone(),
+            ShadowKind::Soft => with_cones_spread(ambient, set),
         };
         Ok(Lighting {
             environment: Self::environment(scene)?,
             illumination: Illumination::Hybrid(
-                light_list(scene, &hybrid.lights, shadows),
+                light_list(scene, set, shadows),
                 Ambient::new(&ambient.rotated(rotation), occlusion_rays),
             ),
         })
@@ -193,11 +194,12 @@ fn with_cones_spread(ambient: &RadianceSh, lights: &LightSet) -> RadianceSh {
             continue;
         }
         let factors = cap_zonal_factors((a / TAU).min(2.0), bands);
-        let y = basis(light.dir(), bands);
+        let y = basis(light.direction, bands);
+        let power = [light.irradiance.r, light.irradiance.g, light.irradiance.b];
         for (l, g) in factors.iter().enumerate() {
             let spread = 1.0 - g;
             for k in l * l..(l + 1) * (l + 1) {
-                for (v, power) in coefficients[k].iter_mut().zip(light.irradiance) {
+                for (v, power) in coefficients[k].iter_mut().zip(power) {
                     *v += power * spread * y[k];
                 }
             }
@@ -240,15 +242,15 @@ fn light_list(scene: &Scene, set: &LightSet, shadows: ShadowKind) -> LightList {
     let lights: Vec<DirectionalLight> = set
         .lights
         .iter()
-        .filter(|l| l.irradiance.iter().any(|&c| c > 0.0))
+        .filter(|l| l.irradiance.any_positive())
         .map(|l| {
-            let direction = (rotation * l.dir()).normalize_or(DVec3::Y).as_vec3();
+            let direction = (rotation * l.direction).normalize_or(DVec3::Y).as_vec3();
             DirectionalLight {
                 direction,
                 irradiance: Rgb::new(
-                    l.irradiance[0] as f32,
-                    l.irradiance[1] as f32,
-                    l.irradiance[2] as f32,
+                    l.irradiance.r as f32,
+                    l.irradiance.g as f32,
+                    l.irradiance.b as f32,
                 ),
                 cone: UniformCone::from_solid_angle(l.solid_angle_sr as f32),
                 frame: OrthonormalBasis::from_normal(direction),
@@ -256,84 +258,4 @@ fn light_list(scene: &Scene, set: &LightSet, shadows: ShadowKind) -> LightList {
         })
         .collect();
     LightList { lights, shadows }
-}
-
-/// The lighting a render asks for: the mode and, for `lights` and `hybrid`, where the lights
-/// come from (the scene's `[lighting]` table with any command-line overrides applied).
-#[derive(Clone, Debug, PartialEq)]
-pub struct LightingPlan {
-    /// The mode.
-    pub mode: ibl_scene::RenderMode,
-    /// Extraction model name: a method (`median-cut`, ...) or `sun` (the dominant light).
-    pub method: String,
-    /// Number of lights to extract.
-    pub lights: usize,
-    /// Lights given ready-made (a light file, in the probe's frame): used instead of extracting.
-    pub given: Option<LightSet>,
-    /// Hard or soft shadows.
-    pub shadows: ShadowKind,
-    /// SH bands of the hybrid ambient.
-    pub ambient_bands: usize,
-    /// Occlusion rays per shading point of the hybrid ambient.
-    pub occlusion_rays: u32,
-    /// Seed of the extraction (clustering restarts).
-    pub seed: u64,
-}
-
-impl LightingPlan {
-    /// The plan of a scene file's `[render]` mode and `[lighting]` table.
-    pub fn from_scene(scene: &Scene) -> LightingPlan {
-        let l = &scene.lighting;
-        LightingPlan {
-            mode: scene.render.mode,
-            method: l.method.clone(),
-            lights: l.lights as usize,
-            given: None,
-            shadows: l.shadows,
-            ambient_bands: l.ambient_bands as usize,
-            occlusion_rays: l.ao_samples,
-            seed: scene.render.seed,
-        }
-    }
-
-    /// Builds the lighting; also returns the light set used (none for the reference). Extraction
-    /// runs on the scene's probe (radiance scale applied), in the probe frame.
-    pub fn build(&self, scene: &Scene) -> Result<(Lighting, Option<LightSet>), crate::RenderError> {
-        use ibl_extract::{ExtractOptions, ModelSpec, build_model};
-        use ibl_scene::RenderMode;
-        if self.mode == RenderMode::Reference {
-            return Ok((Lighting::reference(scene)?, None));
-        }
-        let set = match &self.given {
-            Some(set) => set.clone(),
-            None => {
-                let spec: ModelSpec = self.method.parse()?;
-                if !matches!(spec, ModelSpec::Lights(_)) {
-                    return Err(crate::RenderError::Parameter(format!(
-                        "lighting method '{}' is not a light-extraction method (give the method; \
-                         the hybrid mode adds the SH ambient itself)",
-                        self.method
-                    )));
-                }
-                let options = ExtractOptions { seed: self.seed };
-                let (model, _) = build_model(&scene.probe.radiance, spec, self.lights, &options)?;
-                model.lights().cloned().ok_or_else(|| {
-                    crate::RenderError::Parameter(format!("'{}' made no lights", self.method))
-                })?
-            }
-        };
-        let lighting = match self.mode {
-            RenderMode::Lights => Lighting::lights(scene, &set, self.shadows)?,
-            _ => {
-                let hybrid = Hybrid::from_probe(
-                    &scene.probe.radiance,
-                    set.clone(),
-                    self.ambient_bands,
-                    ibl_sh::Window::None,
-                )?;
-                Lighting::hybrid(scene, &hybrid, self.shadows, self.occlusion_rays)?
-            }
-        };
-        Ok((lighting, Some(set)))
-    }
 }
