@@ -353,7 +353,11 @@ fn demo_writes_every_mapping_and_an_index() {
             .iter()
             .filter(|i| !i["against_reference"].is_null())
             .count();
-        assert_eq!(scored, 4, "{}: 3 light renders and the hybrid", r["name"]);
+        assert_eq!(
+            scored, 5,
+            "{}: 3 soft-shadow light renders, one hard, and the hybrid",
+            r["name"]
+        );
         for chart in r["chart"].as_array().unwrap() {
             assert!(out_dir.join(chart.as_str().unwrap()).exists());
         }
@@ -362,7 +366,7 @@ fn demo_writes_every_mapping_and_an_index() {
         let rows = study["rows"].as_array().unwrap();
         let error = |method: &str, n: u64| {
             rows.iter()
-                .find(|row| row["method"] == method && row["n"] == n)
+                .find(|row| row["method"] == method && row["n"] == n && row["shadows"] == "soft")
                 .and_then(|row| row["relative_mse"].as_f64())
                 .unwrap()
         };

@@ -45,6 +45,9 @@ material = { kind = "diffuse", albedo = [0.75, 0.75, 0.75] }
 [render]
 spp = 2
 bounces = 2
+
+[lighting]
+spp = 2
 "#;
 
 /// A temporary folder holding the probe, the bunny and the scene file.
@@ -114,6 +117,7 @@ fn summary(o: &Output, mode: &str, size: (u64, u64)) -> Value {
         (v["width"].as_u64(), v["height"].as_u64()),
         (Some(size.0), Some(size.1))
     );
+    // `[render] spp` for the reference, `[lighting] spp` for the lights and hybrid modes: both 2.
     assert_eq!(v["spp"], 2);
     assert!(v["rays"].as_u64().unwrap() > 0, "{v}");
     for out in v["outputs"].as_array().unwrap() {
@@ -156,7 +160,8 @@ fn lights_and_hybrid_modes_render_with_layers() {
     );
     let v = summary(&o, "lights", (48, 36));
     assert_eq!(v["lights"]["count"], 4);
-    assert_eq!(v["lights"]["shadows"], "hard");
+    // Soft shadows are the default (docs/SCENES.md).
+    assert_eq!(v["lights"]["shadows"], "soft");
 
     let o = f.render(
         "scene.toml",
@@ -370,7 +375,7 @@ fn an_unwritable_output_format_is_refused_before_rendering() {
 #[test]
 fn a_missing_light_file_named_by_the_scene_names_the_field() {
     let f = Fixture::new();
-    let text = format!("{SCENE}\n[lighting]\nlights_file = \"no-such-lights.json\"\n");
+    let text = format!("{SCENE}lights_file = \"no-such-lights.json\"\n");
     f.write("lights-file.toml", text.as_bytes());
     let o = f.render("lights-file.toml", "l.exr", &["--mode", "lights"]);
     let err = stderr(&o);

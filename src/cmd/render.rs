@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use clap::{Args, ValueEnum};
 use ibl_light::LightSource;
 use ibl_pipeline::render::{Layers, RenderJob, View, render_scene};
-use ibl_scene::{RenderMode, ShadowKind};
+use ibl_scene::{RenderMode, SamplerKind, ShadowKind};
 
 use crate::progress::Bars;
 use crate::values;
@@ -43,6 +43,15 @@ pub enum ShadowArg {
     Soft,
 }
 
+/// Samplers on the command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum SamplerArg {
+    /// Owen-scrambled Sobol points (low discrepancy).
+    Sobol,
+    /// Independent uniform random numbers.
+    Independent,
+}
+
 /// Arguments of `ibl render`.
 #[derive(Args)]
 #[command(after_help = "\
@@ -53,6 +62,7 @@ Examples:
   ibl render scene.toml -o b.exr --mode lights --lights lights.json --shadows soft
   ibl render scene.toml -o h.exr --mode hybrid --method sun -n 1 --spp 16 --json
   ibl render scene.toml -o b.exr --width 640 --spp 256 --layers              + with/without/alpha
+  ibl render scene.toml -o b.exr --sampler independent                       no low discrepancy
 
 Writes OUT (EXR, or any format ibl writes) and OUT's .png preview, tone-mapped with the exposure
 of the background; --layers adds OUT-with, OUT-without (local scene with and without the objects)
@@ -80,9 +90,13 @@ pub struct RenderArgs {
     /// Hard or soft shadows (lights and hybrid).
     #[arg(long, value_enum)]
     pub shadows: Option<ShadowArg>,
-    /// Samples per pixel.
+    /// Samples per pixel (default: the scene's `[render] spp` for the reference, `[lighting] spp`
+    /// for the lights and hybrid modes).
     #[arg(long, value_name = "N")]
     pub spp: Option<u32>,
+    /// Random numbers of the samples (default: the scene's `[render] sampler`, sobol).
+    #[arg(long, value_enum)]
+    pub sampler: Option<SamplerArg>,
     /// Output width in pixels (panorama: height = width / 2; photo: its aspect ratio).
     #[arg(long, value_name = "W")]
     pub width: Option<u32>,
@@ -118,6 +132,10 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             ShadowArg::Soft => ShadowKind::Soft,
         }),
         spp: args.spp,
+        sampler: args.sampler.map(|s| match s {
+            SamplerArg::Sobol => SamplerKind::Sobol,
+            SamplerArg::Independent => SamplerKind::Independent,
+        }),
         width: args.width,
         bounces: args.bounces,
         seed: args.seed,

@@ -41,7 +41,8 @@ pub use ground_truth::{
 pub use ibl_core::{RowIrradiance, channel_means, irradiance_exact};
 pub use plot::{ErrorChart, PLOT_SIZE, PlotError, render_png, render_svg};
 pub use render_study::{
-    RenderStudy, RenderStudyImages, RenderStudyRow, RenderStudySettings, StudyError, render_study,
+    RenderStudy, RenderStudyImages, RenderStudyRow, RenderStudySettings, StudyError, StudyRun,
+    render_study,
 };
 pub use report::LightsNeeded;
 pub use report_files::{FigureFiles, PlotFiles, ReportFiles};

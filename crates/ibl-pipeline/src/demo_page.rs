@@ -175,7 +175,10 @@ pub fn renders_html(results: &[SceneResult]) -> String {
                 .against_reference
                 .map(|(relative_mse, flip)| {
                     format!(
-                        "<br>against the reference: relative MSE {relative_mse:.2e}, FLIP {flip:.3}"
+                        "<br>against the reference: relative MSE {relative_mse:.2e}, FLIP {flip:.3}{}",
+                        image
+                            .speedup
+                            .map_or(String::new(), |x| format!("; {x:.1}x faster"))
                     )
                 })
                 .unwrap_or_default();

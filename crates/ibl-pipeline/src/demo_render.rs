@@ -2,11 +2,15 @@
 //! bunny in an outdoor probe with a hard sun and in an indoor probe) rendered the ways iblkit
 //! offers, and every light approximation scored by its render against the path-traced reference.
 //!
-//! Per scene, into `renders/<scene>/`: the reference composite (perspective view, several bounces),
-//! the same in the whole panorama, light renders with N = 4, 16 and 64 median-cut lights, the
-//! hybrid (16 lights + SH9 ambient with ambient occlusion), the with/without layers of the
-//! reference; then the study of `ibl_eval::render_study` (methods x N = 1..256 against a direct-
-//! light reference) with its table in `renders/report.md` and its chart as SVG and PNG.
+//! Per scene, into `renders/<scene>/`, each at the scene's own settings for its mode
+//! (`RenderSettings::for_scene`): the reference composite (perspective view, several bounces),
+//! the same in the whole panorama, light renders with N = 4, 16 and 64 median-cut lights with soft
+//! shadows and 16 with hard shadows, the hybrid (16 lights + SH9 ambient with directional
+//! occlusion), the with/without layers of the reference, each light render with its time, its
+//! speed-up over the reference and its error against it; then the study of
+//! `ibl_eval::render_study` (methods x N = 1..256 with soft shadows, every method's hybrid at
+//! N = 16, median cut with hard shadows, against a direct-light reference) with its table in
+//! `renders/report.md` and its chart as SVG and PNG.
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -29,16 +33,16 @@ use crate::progress::{Progress, rows};
 const VIEW_WIDTH: u32 = 320;
 /// Width of the demo's panorama composites.
 const PANORAMA_WIDTH: u32 = 512;
-/// Samples per pixel of the demo's reference renders.
-const SHOWCASE_SPP: u32 = 64;
-/// Samples per pixel of the demo's light and hybrid renders (hard shadows need few).
-const LIGHTS_SPP: u32 = 16;
 /// Light counts of the showcase light renders.
 const SHOWCASE_COUNTS: [usize; 3] = [4, 16, 64];
+/// Light count of the showcase's hard-shadow and hybrid renders.
+const SHOWCASE_MODE_LIGHTS: usize = 16;
 /// Width of the study's renders (small: every method at every N is rendered).
 const STUDY_WIDTH: u32 = 128;
 /// Light counts of the study.
 const STUDY_COUNTS: [usize; 9] = [1, 2, 4, 8, 16, 32, 64, 128, 256];
+/// Samples per pixel of the study's path-traced references.
+const STUDY_REFERENCE_SPP: u32 = 512;
 
 /// One image the demo wrote, for the index page.
 #[derive(Clone, Debug, Serialize)]
@@ -49,8 +53,10 @@ pub struct RenderedImage {
     pub preview: String,
     /// The EXR, relative to the demo folder.
     pub exr: String,
-    /// Seconds it took to render.
+    /// Seconds it took to render (lighting built and image rendered).
     pub seconds: f64,
+    /// How many times faster than the reference it rendered (light and hybrid renders only).
+    pub speedup: Option<f64>,
     /// Relative MSE and mean FLIP of the composite against the reference composite (light and
     /// hybrid renders only).
     pub against_reference: Option<(f64, f64)>,
@@ -67,6 +73,15 @@ pub struct SceneResult {
     pub study: RenderStudy,
     /// The study's chart (SVG and PNG), relative to the demo folder.
     pub chart: [String; 2],
+}
+
+/// Whether a showcase image is scored against the reference (time ratio and error).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Scored {
+    /// A light or hybrid render.
+    AgainstReference,
+    /// The reference itself, its layers, the background, the panorama.
+    No,
 }
 
 /// The study's methods: every light extraction method (median cut only at powers of two).
@@ -103,12 +118,13 @@ pub fn demo_renders(dir: &Path, out: &Path, progress: &dyn Progress) -> Result<V
         .join("\n");
     let report = format!(
         "# Renders: light approximations against the path-traced reference\n\n\
-         Per scene: the showcase renders (composites, the reference's bounces) with their error \
-         against the reference composite; then the study, where every method at every N lights \
-         the scene with hard shadows against a path-traced reference of the whole probe \
-         (importance sampling and MIS), both with one bounce (direct light), so the numbers show \
-         what a light set gets wrong about direct light and shadows. The charts are beside this \
-         file.\n\n{md}"
+         Per scene: the showcase renders (composites at the scene's own settings per mode: the \
+         reference's samples and bounces, the lights' antialiasing samples) with their time, \
+         speed-up and error against the reference composite; then the study, where every method \
+         at every N lights the scene (soft shadows unless marked, hybrids at N = 16) against a \
+         path-traced reference of the whole probe (importance sampling and MIS), both with one \
+         bounce (direct light), so the numbers show what a light set gets wrong about direct \
+         light and shadows. The charts are beside this file.\n\n{md}"
     );
     ibl_io::write_atomically(&out.join(RENDER_DIR).join("report.md"), report.as_bytes())?;
     Ok(results)
@@ -117,7 +133,7 @@ pub fn demo_renders(dir: &Path, out: &Path, progress: &dyn Progress) -> Result<V
 /// The showcase renders of a scene and their error against its reference, as Markdown.
 fn showcase_markdown(r: &SceneResult) -> String {
     let mut md = format!(
-        "## {}\n\n| image | seconds | relative MSE vs reference | FLIP vs reference |\n|---|---:|---:|---:|\n",
+        "## {}\n\n| image | seconds | faster than the reference | relative MSE vs reference | FLIP vs reference |\n|---|---:|---:|---:|---:|\n",
         r.name
     );
     for image in &r.images {
@@ -126,9 +142,12 @@ fn showcase_markdown(r: &SceneResult) -> String {
             .map_or(("-".to_string(), "-".to_string()), |(e, f)| {
                 (format!("{e:.2e}"), format!("{f:.3}"))
             });
+        let speedup = image
+            .speedup
+            .map_or("-".to_string(), |x| format!("{x:.1}x"));
         let _ = writeln!(
             md,
-            "| [{}]({}) | {:.1} | {relative_mse} | {flip} |",
+            "| [{}]({}) | {:.2} | {speedup} | {relative_mse} | {flip} |",
             image.caption,
             image.preview.trim_start_matches("renders/"),
             image.seconds
@@ -155,6 +174,7 @@ fn write_render(
         preview: relative(out, &png),
         exr: relative(out, &exr),
         seconds,
+        speedup: None,
         against_reference: None,
     })
 }
@@ -175,7 +195,7 @@ fn demo_scene(path: &Path, name: &str, out: &Path, progress: &dyn Progress) -> R
     let scene = loaded.scene;
     let dir = out.join(RENDER_DIR).join(name);
     ibl_io::create_dir_all(&dir)?;
-    let steps = (SHOWCASE_COUNTS.len() + 3) as u64;
+    let steps = (SHOWCASE_COUNTS.len() + 4) as u64;
     progress.begin(name, steps);
     let showcase = showcase(&scene, &dir, out, &mut |done| {
         progress.update(done, steps, None);
@@ -193,12 +213,15 @@ fn showcase(
     out: &Path,
     step: &mut dyn FnMut(u64),
 ) -> Result<(Vec<RenderedImage>, WriteOptions)> {
+    // The scene's own settings for each mode (docs/SCENES.md): the reference at `[render] spp`
+    // and bounces, the lights and hybrid at `[lighting] spp`, at the showcase width.
     let settings = RenderSettings {
-        composite: scene.render.composite,
         width: Some(VIEW_WIDTH),
-        spp: SHOWCASE_SPP,
-        bounces: scene.render.bounces,
-        seed: scene.render.seed,
+        ..RenderSettings::for_scene(scene, RenderMode::Reference)
+    };
+    let lights_settings = RenderSettings {
+        width: Some(VIEW_WIDTH),
+        ..RenderSettings::for_scene(scene, RenderMode::Lights)
     };
     let base = LightingPlan::from_scene(scene);
     let mut images = Vec::new();
@@ -208,7 +231,7 @@ fn showcase(
         mode: RenderMode::Reference,
         ..base.clone()
     };
-    let (reference, seconds) = timed_render(scene, &reference_plan, &settings)?;
+    let (reference, reference_seconds) = timed_render(scene, &reference_plan, &settings)?;
     let display = WriteOptions {
         display: Display {
             exposure_stops: auto_exposure_stops(&reference.background),
@@ -217,86 +240,97 @@ fn showcase(
         ..WriteOptions::default()
     };
     let reference_composite = reference.composite.clone();
-    // Writes an image; light and hybrid renders also get their error against the reference.
+    // Writes an image; light and hybrid renders also get their speed-up and error against the
+    // reference.
     let mut add = |stem: &str,
                    caption: String,
                    image: &Image<Rgb>,
                    seconds: f64,
-                   error: Option<(f64, f64)>|
+                   scored: Scored|
      -> Result<()> {
         let mut written = write_render(out, dir, stem, caption, image, &display, seconds)?;
-        written.against_reference = error;
+        if scored == Scored::AgainstReference {
+            written.speedup = Some(reference_seconds / seconds.max(1e-9));
+            written.against_reference = Some(against(image, &reference_composite)?);
+        }
         images.push(written);
         Ok(())
     };
     add(
         "reference",
         format!(
-            "reference: path-traced, {} spp, {} bounces, composited ({})",
+            "reference: path-traced, {} spp ({}), {} bounces, composited ({})",
             settings.spp,
+            settings.sampler.name(),
             settings.bounces,
             settings.composite.name()
         ),
         &reference.composite,
-        seconds,
-        None,
+        reference_seconds,
+        Scored::No,
     )?;
     add(
         "reference-with",
         "local scene with the bunny".into(),
         &reference.with_objects,
         0.0,
-        None,
+        Scored::No,
     )?;
     add(
         "reference-without",
         "local scene without it".into(),
         &reference.without_objects,
         0.0,
-        None,
+        Scored::No,
     )?;
     add(
         "background",
         "background".into(),
         &reference.background,
         0.0,
-        None,
+        Scored::No,
     )?;
     step(1);
 
-    let lights_settings = RenderSettings {
-        spp: LIGHTS_SPP,
-        ..settings
-    };
-    for (k, n) in SHOWCASE_COUNTS.into_iter().enumerate() {
-        let plan = LightingPlan::median_cut(scene, RenderMode::Lights, n);
+    let spp = lights_settings.spp;
+    let light_runs = SHOWCASE_COUNTS
+        .iter()
+        .map(|&n| (n, ShadowKind::Soft))
+        .chain(std::iter::once((SHOWCASE_MODE_LIGHTS, ShadowKind::Hard)));
+    for (k, (n, shadows)) in light_runs.enumerate() {
+        let plan = LightingPlan {
+            shadows,
+            ..LightingPlan::median_cut(scene, RenderMode::Lights, n)
+        };
         let (output, seconds) = timed_render(scene, &plan, &lights_settings)?;
+        let shadows = shadows.name();
         add(
-            &format!("lights-median-cut-{n}"),
-            format!("{n} median-cut lights, hard shadows, {LIGHTS_SPP} spp"),
+            &format!("lights-median-cut-{n}-{shadows}"),
+            format!("{n} median-cut lights, {shadows} shadows, {spp} spp"),
             &output.composite,
             seconds,
-            Some(against(&output.composite, &reference_composite)?),
+            Scored::AgainstReference,
         )?;
         step(2 + k as u64);
     }
     let hybrid_plan = LightingPlan {
-        shadows: base.shadows,
-        ..LightingPlan::median_cut(scene, RenderMode::Hybrid, 16)
+        shadows: ShadowKind::Soft,
+        ..LightingPlan::median_cut(scene, RenderMode::Hybrid, SHOWCASE_MODE_LIGHTS)
     };
     let (hybrid, seconds) = timed_render(scene, &hybrid_plan, &lights_settings)?;
     add(
         "hybrid",
         format!(
-            "hybrid: 16 median-cut lights + SH{} ambient, {} occlusion rays, {LIGHTS_SPP} spp",
+            "hybrid: {SHOWCASE_MODE_LIGHTS} median-cut lights (soft shadows) + SH{} ambient, \
+             {} occlusion rays, {spp} spp",
             hybrid_plan.ambient_bands * hybrid_plan.ambient_bands,
             hybrid_plan.occlusion_rays
         ),
         &hybrid.composite,
         seconds,
-        Some(against(&hybrid.composite, &reference_composite)?),
+        Scored::AgainstReference,
     )?;
-    step(2 + SHOWCASE_COUNTS.len() as u64);
+    step(3 + SHOWCASE_COUNTS.len() as u64);
 
     // The whole panorama, when the background is the probe.
     if matches!(scene.background, ibl_scene::Background::Panorama) {
@@ -307,7 +341,7 @@ fn showcase(
         };
         let pano_settings = RenderSettings {
             width: Some(PANORAMA_WIDTH),
-            spp: SHOWCASE_SPP / 4,
+            spp: (settings.spp / 4).max(1),
             ..settings
         };
         let (output, seconds) = timed_render(&panorama, &reference_plan, &pano_settings)?;
@@ -316,10 +350,10 @@ fn showcase(
             format!("the whole panorama, reference, {} spp", pano_settings.spp),
             &output.composite,
             seconds,
-            None,
+            Scored::No,
         )?;
     }
-    step(3 + SHOWCASE_COUNTS.len() as u64);
+    step(4 + SHOWCASE_COUNTS.len() as u64);
     Ok((images, display))
 }
 
@@ -334,17 +368,43 @@ fn study(
     images: Vec<RenderedImage>,
     progress: &dyn Progress,
 ) -> Result<SceneResult> {
+    // Every method at every N with soft shadows; the hybrid of every method at the showcase's N;
+    // median cut with hard shadows at every N.
+    let base = LightingPlan::from_scene(scene);
+    let lights_defaults = RenderSettings::for_scene(scene, RenderMode::Lights);
+    let methods = study_methods();
+    let hybrids: Vec<ModelSpec> = methods
+        .iter()
+        .filter_map(|m| match m {
+            ModelSpec::Lights(source) => Some(ModelSpec::Hybrid {
+                lights: *source,
+                bands: base.ambient_bands,
+            }),
+            _ => None,
+        })
+        .collect();
+    let mut runs = RenderStudySettings::grid(&methods, &STUDY_COUNTS, ShadowKind::Soft);
+    runs.extend(RenderStudySettings::grid(
+        &hybrids,
+        &[SHOWCASE_MODE_LIGHTS],
+        ShadowKind::Soft,
+    ));
+    runs.extend(RenderStudySettings::grid(
+        &[ModelSpec::from(Method::MedianCut)],
+        &STUDY_COUNTS,
+        ShadowKind::Hard,
+    ));
     let study_settings = RenderStudySettings {
-        methods: study_methods(),
-        counts: STUDY_COUNTS.to_vec(),
+        runs,
         width: Some(STUDY_WIDTH),
-        reference_spp: 512,
-        lights_spp: 4,
+        reference_spp: STUDY_REFERENCE_SPP,
+        lights_spp: lights_defaults.spp,
         bounces: 1,
-        shadows: ShadowKind::Hard,
+        sampler: lights_defaults.sampler,
+        occlusion_rays: base.occlusion_rays,
         seed: scene.render.seed,
     };
-    let runs = study_settings.methods.len() * study_settings.counts.len() + 2;
+    let runs = study_settings.runs.len() + 2;
     progress.begin(&format!("{name}: study"), runs as u64);
     let studied = render_study(scene, name, &study_settings, &rows(progress));
     progress.end();
@@ -356,9 +416,10 @@ fn study(
         &study_images.reference.with_objects,
         display,
     )?;
-    for (method, n, output) in &study_images.lights {
+    for (label, n, output) in &study_images.lights {
+        let stem = label.replace(" (", "-").replace(')', "");
         ibl_io::write_image(
-            &study_dir.join(format!("{method}-{n}.png")),
+            &study_dir.join(format!("{stem}-{n}.png")),
             &output.with_objects,
             display,
         )?;

@@ -113,7 +113,6 @@ impl LightingPlan {
                     scene,
                     &hybrid.lights,
                     &hybrid.ambient,
-                    Window::None,
                     self.shadows,
                     self.occlusion_rays,
                 )

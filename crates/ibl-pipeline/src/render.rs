@@ -12,7 +12,7 @@ use ibl_core::tonemap::{Display, auto_exposure_stops};
 use ibl_core::{Image, Rgb};
 use ibl_io::WriteOptions;
 use ibl_light::LightSource;
-use ibl_render::{RenderOutput, RenderSettings};
+use ibl_render::{RenderOutput, RenderSettings, SamplerKind};
 use ibl_scene::description::{MAX_BOUNCES, MAX_SPP, MAX_WIDTH};
 use ibl_scene::{RenderMode, ShadowKind};
 use serde::Serialize;
@@ -59,8 +59,11 @@ pub struct RenderJob {
     pub lights: Option<usize>,
     /// Shadows of the lights and hybrid modes.
     pub shadows: Option<ShadowKind>,
-    /// Samples per pixel.
+    /// Samples per pixel (`None`: the scene's `[render] spp` for the reference, `[lighting] spp`
+    /// for the lights and hybrid modes).
     pub spp: Option<u32>,
+    /// Random numbers of the samples.
+    pub sampler: Option<SamplerKind>,
     /// Output width in pixels.
     pub width: Option<u32>,
     /// Surface vertices per path.
@@ -103,6 +106,8 @@ pub struct RenderSummary {
     pub bounces: u32,
     /// Seed.
     pub seed: u64,
+    /// `sobol` or `independent`.
+    pub sampler: &'static str,
     /// Seconds to make the lighting.
     pub seconds_lighting: f64,
     /// Seconds to render.
@@ -166,12 +171,14 @@ pub fn render_scene(job: &RenderJob, progress: &dyn Progress) -> Result<RenderSu
             (false, Err(e)) => return Err(e.context(format!("{scene_name}: lighting.lights_file"))),
         };
     }
+    let defaults = RenderSettings::for_scene(scene, plan.mode);
     let settings = RenderSettings {
-        composite: scene.render.composite,
-        width: job.width.or(scene.render.width),
-        spp: job.spp.unwrap_or(scene.render.spp),
-        bounces: job.bounces.unwrap_or(scene.render.bounces),
-        seed: job.seed.unwrap_or(scene.render.seed),
+        width: job.width.or(defaults.width),
+        spp: job.spp.unwrap_or(defaults.spp),
+        bounces: job.bounces.unwrap_or(defaults.bounces),
+        seed: job.seed.unwrap_or(defaults.seed),
+        sampler: job.sampler.unwrap_or(defaults.sampler),
+        ..defaults
     };
     check_settings(&settings)?;
 
@@ -207,6 +214,7 @@ pub fn render_scene(job: &RenderJob, progress: &dyn Progress) -> Result<RenderSu
         spp: stats.spp,
         bounces: settings.bounces,
         seed: settings.seed,
+        sampler: settings.sampler.name(),
         seconds_lighting,
         seconds_render,
         rays: stats.rays,

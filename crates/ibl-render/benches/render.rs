@@ -16,7 +16,7 @@ use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use ibl_extract::{ExtractOptions, extract};
 use ibl_light::Method;
 use ibl_render::lighting::Lighting;
-use ibl_render::{RenderSettings, render};
+use ibl_render::{RenderSettings, SamplerKind, render};
 use ibl_scene::description::CompositeRule;
 use ibl_scene::{Camera, Scene, ShadowKind};
 
@@ -35,6 +35,7 @@ fn bench_rays(c: &mut Criterion) {
         spp: 4,
         bounces: 4,
         seed: 1,
+        sampler: SamplerKind::Sobol,
     };
     let rays = render(&scene, &lighting, &settings, &|_, _| {})
         .expect("render")
@@ -69,6 +70,7 @@ fn bench_differential(c: &mut Criterion) {
         spp: 1,
         bounces: 1,
         seed: 1,
+        sampler: SamplerKind::Sobol,
     };
     let mut group = c.benchmark_group("differential");
     group.sample_size(10);

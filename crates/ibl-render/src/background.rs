@@ -1,82 +1,49 @@
-//! The background a render is composited into, at the output size.
+//! The background a render is composited into, at the output size: in every case the mean, over
+//! each output pixel's area, of what the camera sees there (the same quantity the pixel's
+//! jittered samples estimate where they meet geometry, so partly covered pixels blend
+//! consistently).
 //!
-//! - A panorama background is the probe itself: at the probe's own size it is the probe image,
-//!   pixel for pixel (so an empty scene composites to exactly the probe); at another size it is
-//!   the probe resampled with `ibl-mapping`'s energy-conserving lat-long resampling.
+//! - A panorama background seen by the panorama camera is the probe itself: at the probe's own
+//!   size the probe image, pixel for pixel (so an empty scene composites to exactly the probe); at
+//!   another size each output pixel is a rectangle of texel coordinates, and its value the exact
+//!   area mean of the piecewise-constant probe over it ([`area_resize`]).
 //! - A perspective view of the panorama (a pinhole `[camera]` with a panorama background) shows
-//!   in each pixel the mean probe radiance over a 4 x 4 grid of rays through the pixel (nearest
-//!   texel each): exact for a camera at the probe's centre, with parallax error elsewhere.
-//! - A photograph at its own size is itself; at a smaller or larger output size it is box-filtered:
-//!   each output pixel averages the photo over its footprint, weighting partly covered photo
-//!   pixels by the covered area (exact area integral of the piecewise-constant photo). O(W H k^2)
-//!   for a reduction factor k.
+//!   in each pixel the mean of the probe over the pixel's footprint on the sphere
+//!   ([`crate::footprint`]: exact for the piecewise-constant probe up to the footprint's curvature
+//!   within a cell), as seen from the probe's centre (no parallax: the probe is at infinity).
+//! - A photograph at its own size is itself; at a smaller or larger output size it is box-filtered
+//!   by the same exact area mean. O(W H k^2) for a reduction factor k.
 
-use glam::Mat3;
-use ibl_core::LatLong;
 use ibl_core::{Image, Rgb};
-use ibl_mapping::{Mapping, resample};
 use ibl_scene::{Background, Camera, Scene};
 
-use crate::RenderError;
+use crate::footprint::PixelFootprint;
 
 /// The scene's background at `width x height`.
-pub fn background_image(scene: &Scene, width: u32, height: u32) -> Result<Image<Rgb>, RenderError> {
+pub fn background_image(scene: &Scene, width: u32, height: u32) -> Image<Rgb> {
     let (w, h) = (width as usize, height as usize);
+    let probe = &scene.probe.radiance;
     match &scene.background {
         Background::Panorama if matches!(scene.camera, Camera::Pinhole { .. }) => {
-            Ok(probe_view(scene, width, height))
+            let footprint = PixelFootprint::new(
+                probe,
+                &scene.camera,
+                scene.probe.world_from_probe,
+                width,
+                height,
+            );
+            Image::from_fn_par(w, h, |x, y| footprint.mean(x as u32, y as u32))
         }
-        Background::Panorama => {
-            let probe = &scene.probe.radiance;
-            if probe.width() == w && probe.height() == h {
-                Ok(probe.clone())
-            } else {
-                resample(
-                    probe,
-                    Mapping::LatLong,
-                    Mapping::LatLong,
-                    w,
-                    h,
-                    Mat3::IDENTITY,
-                    &|_, _| {},
-                )
-                .map_err(|e| RenderError::Parameter(format!("resampling the panorama: {e}")))
-            }
-        }
-        Background::Photo(photo) => Ok(if photo.width() == w && photo.height() == h {
-            photo.clone()
-        } else {
-            area_resize(photo, w, h)
-        }),
+        Background::Panorama if probe.width() == w && probe.height() == h => probe.clone(),
+        Background::Panorama => area_resize(probe, w, h),
+        Background::Photo(photo) if photo.width() == w && photo.height() == h => photo.clone(),
+        Background::Photo(photo) => area_resize(photo, w, h),
     }
 }
 
-/// Sub-pixel rays per axis of [`probe_view`].
-const VIEW_SUBSAMPLES: usize = 4;
-
-/// The probe seen through the scene's pinhole camera.
-fn probe_view(scene: &Scene, width: u32, height: u32) -> Image<Rgb> {
-    let probe = &scene.probe.radiance;
-    let grid = LatLong::new(probe.width(), probe.height());
-    let probe_from_world = scene.probe.world_from_probe.transpose();
-    let n = VIEW_SUBSAMPLES;
-    Image::from_fn_par(width as usize, height as usize, |x, y| {
-        let mut sum = Rgb::ZERO;
-        for sy in 0..n {
-            for sx in 0..n {
-                let px = x as f32 + (sx as f32 + 0.5) / n as f32;
-                let py = y as f32 + (sy as f32 + 0.5) / n as f32;
-                let ray = scene.camera.ray(px, py, width, height);
-                let (i, j) = grid.dir_to_pixel((probe_from_world * ray.direction).as_dvec3());
-                sum += *probe.get(i, j);
-            }
-        }
-        sum / (n * n) as f32
-    })
-}
-
-/// Area-weighted resize of a piecewise-constant image.
-fn area_resize(src: &Image<Rgb>, width: usize, height: usize) -> Image<Rgb> {
+/// Area-weighted resize of a piecewise-constant image: each output pixel the exact mean of `src`
+/// over its rectangle (fractional pixels weighted by their covered area).
+pub fn area_resize(src: &Image<Rgb>, width: usize, height: usize) -> Image<Rgb> {
     let sx = src.width() as f64 / width as f64;
     let sy = src.height() as f64 / height as f64;
     Image::from_fn_par(width, height, |x, y| {

@@ -7,19 +7,24 @@
 //! - [`lighting`]: what lights each mode (environment, directional lights, lights + SH ambient).
 //! - [`background`]: the background at the output size.
 //! - [`environment`]: the probe as an importance-sampled environment light.
+//! - [`footprint`]: the probe's mean over a pinhole pixel's footprint (the background).
 //! - [`material`]: BSDFs of the scene's materials (evaluate, sample, density).
-//! - [`sampling`]: per-sample random streams, warps and discrete distributions.
+//! - [`sampler`]: the numbers each pixel sample draws (Owen-scrambled Sobol or independent).
+//! - [`sampling`]: random number generator, warps and discrete distributions.
 
 pub mod background;
 pub mod environment;
+pub mod footprint;
 pub mod lighting;
 pub mod material;
 pub mod render;
+pub mod sampler;
 pub mod sampling;
 pub mod tracer;
 
 pub use lighting::{Illumination, Lighting};
 pub use render::{RenderOutput, RenderSettings, RenderStats, render};
+pub use sampler::SamplerKind;
 
 /// Why a render cannot be made.
 #[derive(Debug, thiserror::Error)]

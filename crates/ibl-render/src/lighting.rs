@@ -3,23 +3,44 @@
 //! - **reference**: the whole probe as an environment light, importance-sampled
 //!   ([`EnvironmentLight`]), combined with BSDF sampling by multiple importance sampling;
 //! - **lights**: a [`LightSet`] of directional lights, each with hard shadows (one shadow ray along
-//!   its direction) or soft shadows (shadow rays spread uniformly over a cone of the light's own
-//!   solid angle `A_i`, half-angle `acos(1 - A_i / 2 pi)`);
-//! - **hybrid**: the important lights with shadows plus an SH ambient (the probe minus the lights,
-//!   as `ibl_extract::Hybrid` makes it) whose irradiance is attenuated by ambient occlusion.
+//!   its direction) or soft shadows (the light is a cone of uniform radiance of its own solid
+//!   angle `A_i`, half-angle `acos(1 - A_i / 2 pi)`: a window is not a point), evaluated at the
+//!   first diffuse or glossy surface a camera ray (or its mirror reflections) meets: deterministic
+//!   direct light, one shadow ray per light per pixel sample;
+//! - **hybrid**: the lights as above plus an SH ambient radiance `L_a`, the probe minus what the
+//!   lights carry ([`Ambient`]), seen through cosine-distributed occlusion rays.
+//!
+//! **The hybrid's ambient.** `ibl_extract::Hybrid` subtracts each light as a point source,
+//! `L_a,lm = L_lm - sum_i I_i Y_lm(w_i)`, which is right for hard shadows. A soft light is a cone,
+//! whose projection is its point projection times the cap's zonal factor
+//! `g_l = (P_{l-1}(c) - P_{l+1}(c)) / ((2l + 1)(1 - c))`, `c = cos(half-angle)` (the mean of
+//! `P_l` over the cap, by `int_c^1 P_l = (P_{l-1}(c) - P_{l+1}(c)) / (2l + 1)` and the addition
+//! theorem; `g_0 = 1`, `g_l -> 1` for a point): so with soft shadows the ambient gets back
+//! `sum_i I_i (1 - g_l) Y_lm(w_i)`, and lights plus ambient carry exactly the probe's low bands
+//! whatever the shadow kind. Where the lights cover the probe (median cut) the ambient is the
+//! small, signed low-band difference between the probe and the lights; where they do not (the
+//! `sun` method) it is the rest of the sky. Either way it is shadowed per direction
+//! ("directional occlusion"): a diffuse vertex adds `albedo * mean_k V(w_k) L_a(w_k)` over `k`
+//! cosine-distributed directions `w_k` (`f cos / pdf = albedo`), so an occluder darkens only the
+//! part of the ambient it hides. The former scheme, `albedo E_a(n) / pi` times the fraction of
+//! open rays, clamped `E_a` at 0 where the signed difference is negative and darkened every
+//! direction alike: near-black patches on the bunny. The vertex's light (lights plus ambient) is
+//! clamped at 0 per channel.
 //!
 //! In every mode the environment is still what a perfect mirror reflects and what the camera sees
 //! where it sees no geometry; only diffuse and glossy reflection use the approximation. Lights come
 //! from the probe in its own frame and are rotated by `world_from_probe` here, as is the ambient.
 
-use glam::{DMat3, Vec3};
+use std::f64::consts::TAU;
+
+use glam::{DMat3, DVec3, Vec3};
 use ibl_core::Rgb;
 use ibl_light::LightSet;
 use ibl_scene::{Scene, ShadowKind};
-use ibl_sh::{IrradianceSh, RadianceSh};
+use ibl_sh::{RadianceSh, basis, eval_basis};
 
 use crate::environment::{EnvironmentError, EnvironmentLight};
-use crate::sampling::{Distribution1D, UniformCone};
+use crate::sampling::{OrthonormalBasis, UniformCone};
 
 /// One directional light, world frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -30,6 +51,8 @@ pub struct DirectionalLight {
     pub irradiance: Rgb,
     /// The cone of the light's solid angle (soft shadows), `None` for a point-like light.
     pub cone: Option<UniformCone>,
+    /// The basis about `direction` in which the cone is sampled.
+    pub frame: OrthonormalBasis,
 }
 
 /// The directional part of the `lights` and `hybrid` modes.
@@ -39,17 +62,50 @@ pub struct LightList {
     pub lights: Vec<DirectionalLight>,
     /// Hard or soft shadows.
     pub shadows: ShadowKind,
-    /// Picks one light in proportion to its luminous irradiance (secondary vertices).
-    pub choice: Distribution1D,
 }
 
-/// The ambient of the `hybrid` mode.
+/// Largest SH band count of the hybrid ambient (`[lighting] ambient_bands`).
+pub const MAX_AMBIENT_BANDS: usize = 16;
+
+/// The ambient of the `hybrid` mode: an SH radiance, world frame, seen through occlusion rays.
 #[derive(Clone, Debug)]
 pub struct Ambient {
-    /// Irradiance of the ambient radiance, world frame.
-    pub irradiance: IrradianceSh,
-    /// Occlusion rays per shading point.
+    /// Bands of `radiance`, 1 to [`MAX_AMBIENT_BANDS`].
+    bands: usize,
+    /// `bands^2` RGB coefficients of the ambient radiance (probe units), world frame.
+    coefficients: Vec<[f64; 3]>,
+    /// Occlusion rays per shading point, at least 1.
     pub occlusion_rays: u32,
+}
+
+impl Ambient {
+    /// The ambient of radiance `radiance` (world frame; its bands are cut to
+    /// [`MAX_AMBIENT_BANDS`]) with `occlusion_rays` rays per shading point (at least 1).
+    pub fn new(radiance: &RadianceSh, occlusion_rays: u32) -> Ambient {
+        let bands = radiance.bands().clamp(1, MAX_AMBIENT_BANDS);
+        let mut coefficients = radiance.coefficients().to_vec();
+        coefficients.resize(bands * bands, [0.0; 3]);
+        Ambient {
+            bands,
+            coefficients,
+            occlusion_rays: occlusion_rays.max(1),
+        }
+    }
+
+    /// The ambient radiance arriving from the unit world direction `dir` (may be negative:
+    /// the ambient is a difference). O(bands^2).
+    pub fn radiance(&self, dir: Vec3) -> Rgb {
+        let mut y = [0.0f64; MAX_AMBIENT_BANDS * MAX_AMBIENT_BANDS];
+        let n = self.bands * self.bands;
+        eval_basis(dir.as_dvec3(), self.bands, &mut y[..n]);
+        let mut sum = [0.0f64; 3];
+        for (c, yk) in self.coefficients.iter().zip(&y[..n]) {
+            for k in 0..3 {
+                sum[k] += c[k] * yk;
+            }
+        }
+        Rgb::new(sum[0] as f32, sum[1] as f32, sum[2] as f32)
+    }
 }
 
 /// How diffuse and glossy surfaces are lit.
@@ -102,28 +158,83 @@ impl Lighting {
         })
     }
 
-    /// `hybrid` mode: the lights `set` and the `ambient` radiance (the probe minus the lights, in
-    /// SH) are in the probe's frame.
+    /// `hybrid` mode: the lights `set` and the `ambient` radiance (the probe minus the lights as
+    /// point sources, as `ibl_extract::Hybrid` makes it) are in the probe's frame; with soft
+    /// shadows the ambient gives back what the cones spread (see the module notes).
     pub fn hybrid(
         scene: &Scene,
         set: &LightSet,
         ambient: &RadianceSh,
-        window: ibl_sh::Window,
         shadows: ShadowKind,
         occlusion_rays: u32,
     ) -> Result<Lighting, EnvironmentError> {
         let rotation = scene.probe.world_from_probe.as_dmat3();
+        let ambient = match shadows {
+            ShadowKind::Hard => ambient.clone(),
+            ShadowKind::Soft => with_cones_spread(ambient, set),
+        };
         Ok(Lighting {
             environment: Self::environment(scene)?,
             illumination: Illumination::Hybrid(
                 light_list(scene, set, shadows),
-                Ambient {
-                    irradiance: ambient.rotated(rotation).irradiance(window),
-                    occlusion_rays: occlusion_rays.max(1),
-                },
+                Ambient::new(&ambient.rotated(rotation), occlusion_rays),
             ),
         })
     }
+}
+
+/// `ambient + sum_i I_i (1 - g_l(c_i)) Y_lm(w_i)`: a point-subtracted ambient turned into the
+/// ambient of the same lights as uniform cones (module notes), probe frame.
+fn with_cones_spread(ambient: &RadianceSh, lights: &LightSet) -> RadianceSh {
+    let bands = ambient.bands();
+    let mut coefficients = ambient.coefficients().to_vec();
+    for light in &lights.lights {
+        let a = light.solid_angle_sr;
+        if !(a.is_finite() && a > 0.0) {
+            continue;
+        }
+        let factors = cap_zonal_factors((a / TAU).min(2.0), bands);
+        let y = basis(light.direction, bands);
+        let power = [light.irradiance.r, light.irradiance.g, light.irradiance.b];
+        for (l, g) in factors.iter().enumerate() {
+            let spread = 1.0 - g;
+            for k in l * l..(l + 1) * (l + 1) {
+                for (v, power) in coefficients[k].iter_mut().zip(power) {
+                    *v += power * spread * y[k];
+                }
+            }
+        }
+    }
+    // The coefficient count is unchanged, so this cannot fail.
+    RadianceSh::new(bands, coefficients).unwrap_or_else(|_| ambient.clone())
+}
+
+/// The mean of the Legendre polynomial `P_l` over a spherical cap whose half-angle has cosine
+/// `c = 1 - one_minus_c` (`one_minus_c` in `(0, 2]`; the cap's solid angle is `2 pi one_minus_c`),
+/// for `l < bands`: `g_0 = 1`, `g_l = (P_{l-1}(c) - P_{l+1}(c)) / ((2l + 1)(1 - c))`. Caps
+/// narrower than `1 - c = 1e-9` count as points (`g_l = 1`; the first-order term is
+/// `l (l + 1) (1 - c) / 4`, below 7e-8 for 16 bands). f64; the difference of Legendre values
+/// loses about `1e-16 / (1 - c)` relative, below 1e-7 for every cap that is not a point.
+pub fn cap_zonal_factors(one_minus_c: f64, bands: usize) -> Vec<f64> {
+    if one_minus_c < 1e-9 {
+        return vec![1.0; bands];
+    }
+    let c = 1.0 - one_minus_c;
+    // P_0 .. P_bands at c (Bonnet's recursion).
+    let mut p = vec![1.0, c];
+    for l in 1..bands {
+        let next = ((2 * l + 1) as f64 * c * p[l] - l as f64 * p[l - 1]) / (l + 1) as f64;
+        p.push(next);
+    }
+    (0..bands)
+        .map(|l| {
+            if l == 0 {
+                1.0
+            } else {
+                (p[l - 1] - p[l + 1]) / ((2 * l + 1) as f64 * one_minus_c)
+            }
+        })
+        .collect()
 }
 
 fn light_list(scene: &Scene, set: &LightSet, shadows: ShadowKind) -> LightList {
@@ -132,20 +243,19 @@ fn light_list(scene: &Scene, set: &LightSet, shadows: ShadowKind) -> LightList {
         .lights
         .iter()
         .filter(|l| l.irradiance.any_positive())
-        .map(|l| DirectionalLight {
-            direction: (rotation * l.direction).normalize().as_vec3(),
-            irradiance: Rgb::new(
-                l.irradiance.r as f32,
-                l.irradiance.g as f32,
-                l.irradiance.b as f32,
-            ),
-            cone: UniformCone::from_solid_angle(l.solid_angle_sr as f32),
+        .map(|l| {
+            let direction = (rotation * l.direction).normalize_or(DVec3::Y).as_vec3();
+            DirectionalLight {
+                direction,
+                irradiance: Rgb::new(
+                    l.irradiance.r as f32,
+                    l.irradiance.g as f32,
+                    l.irradiance.b as f32,
+                ),
+                cone: UniformCone::from_solid_angle(l.solid_angle_sr as f32),
+                frame: OrthonormalBasis::from_normal(direction),
+            }
         })
         .collect();
-    let choice = Distribution1D::new(lights.iter().map(|l| f64::from(l.irradiance.luminance())));
-    LightList {
-        lights,
-        shadows,
-        choice,
-    }
+    LightList { lights, shadows }
 }

@@ -17,22 +17,24 @@
 //! empty scene, or any pixel the objects do not affect, composites to `B` bit for bit (`B * 1.0 +
 //! 0.0`). Negative results (a modelled shadow darker than the photographed surface) clamp to 0.
 //!
-//! Every pixel sample draws from its own random stream `(seed, pixel, sample)`, rows run in
-//! parallel with rayon, and each pixel sums its samples in order: the image depends on the seed
-//! only, never on the thread count. Cost: O(W H n) paths (see [`crate::tracer`] per path).
+//! Every pixel sample draws from its own stream `(seed, pixel, sample)` ([`crate::sampler`]:
+//! Owen-scrambled Sobol by default, so the pixel's samples are stratified in the pixel and in
+//! every later pair of dimensions), rows run in parallel with rayon, and each pixel sums its
+//! samples in order: the image depends on the seed only, never on the thread count. Cost:
+//! O(W H n) paths (see [`crate::tracer`] per path).
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use ibl_core::{Image, Rgb};
-use ibl_scene::Scene;
 use ibl_scene::description::CompositeRule;
+use ibl_scene::{RenderMode, Scene};
 use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::RenderError;
 use crate::background::background_image;
 use crate::lighting::Lighting;
-use crate::sampling::PixelRng;
+use crate::sampler::{SOBOL_MAX_SAMPLES, SampleStream, SamplerKind};
 use crate::tracer::{Layers, PrimaryHit, Tracer};
 
 /// How to render.
@@ -42,12 +44,35 @@ pub struct RenderSettings {
     pub composite: CompositeRule,
     /// Output width in pixels (`None`: the background's own width).
     pub width: Option<u32>,
-    /// Samples per pixel, at least 1.
+    /// Samples per pixel, at least 1 (at most `2^16` with the Sobol sampler).
     pub spp: u32,
-    /// Surface vertices per path, at least 1 (1 = direct light only).
+    /// Surface vertices per path, at least 1 (1 = direct light only). The lights and hybrid
+    /// modes end a path at its first diffuse or glossy vertex; this bounds their mirror chains.
     pub bounces: u32,
     /// Seed of every random number.
     pub seed: u64,
+    /// Which random numbers the samples draw.
+    pub sampler: SamplerKind,
+}
+
+impl RenderSettings {
+    /// The settings a scene file asks for when rendering in `mode`: `[render]`'s width, bounces,
+    /// seed, composite rule and sampler, and its `spp` for the reference or `[lighting]`'s `spp`
+    /// (antialiasing samples) for the lights and hybrid modes.
+    pub fn for_scene(scene: &Scene, mode: RenderMode) -> RenderSettings {
+        let r = &scene.render;
+        RenderSettings {
+            composite: r.composite,
+            width: r.width,
+            spp: match mode {
+                RenderMode::Reference => r.spp,
+                RenderMode::Lights | RenderMode::Hybrid => scene.lighting.spp,
+            },
+            bounces: r.bounces,
+            seed: r.seed,
+            sampler: r.sampler,
+        }
+    }
 }
 
 /// What a render counted.
@@ -116,6 +141,12 @@ pub fn render(
             "samples per pixel must be at least 1".into(),
         ));
     }
+    if settings.sampler == SamplerKind::Sobol && settings.spp > SOBOL_MAX_SAMPLES {
+        return Err(RenderError::Parameter(format!(
+            "the sobol sampler takes at most {SOBOL_MAX_SAMPLES} samples per pixel ({} asked)",
+            settings.spp
+        )));
+    }
     let default_width = match &scene.background {
         ibl_scene::Background::Panorama => scene.probe.radiance.width() as u32,
         ibl_scene::Background::Photo(photo) => photo.width() as u32,
@@ -126,7 +157,7 @@ pub fn render(
             "{width} x {height} is more than {MAX_PIXELS} pixels"
         )));
     }
-    let background = background_image(scene, width, height)?;
+    let background = background_image(scene, width, height);
     let tracer = Tracer::new(scene, lighting, settings.bounces);
     let (w, h) = (width as usize, height as usize);
     let rows_done = AtomicUsize::new(0);
@@ -229,9 +260,17 @@ fn pixel(
 ) -> PixelSums {
     let index = (y as u64) * u64::from(width) + x as u64;
     let mut sums = PixelSums::default();
+    // The stream of sample `s`, and the same stream after its pixel jitter (the pass without the
+    // objects draws exactly the numbers the pass with them drew).
+    let stream = |s: u32| SampleStream::new(settings.sampler, settings.seed, index, s);
+    let after_jitter = |s: u32| {
+        let mut stream = stream(s);
+        stream.next_2d();
+        stream
+    };
     for s in 0..settings.spp {
-        let mut rng = PixelRng::new(settings.seed, index, s);
-        let (jx, jy) = (rng.next_f32(), rng.next_f32());
+        let mut rng = stream(s);
+        let [jx, jy] = rng.next_2d();
         let ray = scene
             .camera
             .ray(x as f32 + jx, y as f32 + jy, width, height);
@@ -243,9 +282,7 @@ fn pixel(
                 sums.with += with.radiance;
                 sums.object_samples += 1;
                 // The same camera ray without the objects, for the "without" layer.
-                let mut rng = PixelRng::new(settings.seed, index, s);
-                let _ = (rng.next_f32(), rng.next_f32());
-                let without = tracer.trace(ray, Layers::RealOnly, &mut rng);
+                let without = tracer.trace(ray, Layers::RealOnly, &mut after_jitter(s));
                 sums.without += without.radiance;
                 sums.rays += without.rays;
                 sums.paths_without += 1;
@@ -254,15 +291,21 @@ fn pixel(
             PrimaryHit::Real => {
                 sums.with += with.radiance;
                 if with.touched_virtual {
-                    let mut rng = PixelRng::new(settings.seed, index, s);
-                    let _ = (rng.next_f32(), rng.next_f32());
-                    let without = tracer.trace(ray, Layers::RealOnly, &mut rng);
-                    sums.without += without.radiance;
-                    sums.difference += with.radiance - without.radiance;
+                    // The lights and hybrid modes usually evaluated the path without the objects
+                    // in the same walk; otherwise it is walked again through the real layer.
+                    let without = match with.without_objects {
+                        Some(radiance) => radiance,
+                        None => {
+                            let again = tracer.trace(ray, Layers::RealOnly, &mut after_jitter(s));
+                            sums.rays += again.rays;
+                            sums.paths_without += 1;
+                            again.radiance
+                        }
+                    };
+                    sums.without += without;
+                    sums.difference += with.radiance - without;
                     sums.real_with += with.radiance;
-                    sums.real_without += without.radiance;
-                    sums.rays += without.rays;
-                    sums.paths_without += 1;
+                    sums.real_without += without;
                 } else {
                     sums.without += with.radiance;
                     sums.real_with += with.radiance;

@@ -1,37 +1,55 @@
 //! One light path per call: the radiance arriving at the camera along a primary ray, in one of
 //! the three lighting modes, through the scene with or without its virtual objects.
 //!
-//! The estimator is a unidirectional path tracer (Kajiya 1986) with next-event estimation:
-//! - **reference**: at each diffuse or glossy vertex one environment sample (importance-sampled
-//!   by texel power) and the BSDF sample that continues the path are combined by the power
-//!   heuristic (Veach 1997, multiple importance sampling); an escaping BSDF sample adds the probe's
-//!   radiance with the complementary weight. Mirrors are delta: escaping mirror rays add the probe
-//!   unweighted.
-//! - **lights**: at the first vertex every light is evaluated with its own shadow ray (no noise
-//!   from light choice); at later vertices one light is picked in proportion to its luminance.
-//!   Escaping rays add the probe only after a mirror (the lights stand for the rest of it).
-//! - **hybrid**: as lights, plus the ambient's irradiance times `albedo / pi` times the fraction
-//!   of cosine-distributed occlusion rays that escape; the path then stops at diffuse and glossy
-//!   vertices (the ambient already holds the indirect light), and continues through mirrors.
+//! - **reference**: a unidirectional path tracer (Kajiya 1986) with next-event estimation. At each
+//!   diffuse or glossy vertex one environment sample (importance-sampled by texel power) and the
+//!   BSDF sample that continues the path are combined by the power heuristic (Veach 1997, multiple
+//!   importance sampling); an escaping BSDF sample adds the probe's radiance with the
+//!   complementary weight. Mirrors are delta: escaping mirror rays add the probe unweighted. Paths
+//!   stop after `bounces` surface vertices, with Russian roulette from the fourth vertex on
+//!   (survival probability = the throughput's largest channel, at most 0.95). Unbiased: the judge
+//!   of every approximation.
+//! - **lights**: deterministic direct light. At the first diffuse or glossy vertex (after any
+//!   mirror bounces, which are followed exactly) every light is evaluated with its own shadow ray:
+//!   along its direction (hard) or towards a point of its cone drawn from one 2-D sample of the
+//!   pixel sample's stream (soft; the Sobol stream stratifies each light's cone points across the
+//!   pixel's samples). The path then ends: there is no indirect light, and no noise but the
+//!   antialiasing and soft-shadow sampling. Escaping rays add the probe only after a mirror.
+//! - **hybrid**: as lights, plus the ambient radiance `L_a` seen through `k` cosine-distributed
+//!   occlusion rays: `albedo * mean_k V(w_k) L_a(w_k)` (directional occlusion,
+//!   [`crate::lighting`]).
 //!
-//! Paths stop after `bounces` surface vertices, with Russian roulette from the fourth vertex on
-//! (survival probability = the throughput's largest channel, at most 0.95).
+//! Ray origins leave a surface by its hit point's error bound (pbrt-v4 section 6.8.6): the point
+//! moves along the geometric normal by `d = |n| . err` (`err` the per-axis bound of
+//! [`SurfacePoint::position_error`]) to the side the ray leaves on, and each coordinate is
+//! rounded one ulp further away; with the BVH's conservative `t > delta_t` test no ray can hit the
+//! surface it leaves, and the offset is set by the hit's own coordinates (about `4e-7` of their
+//! magnitude), never by the size of the scene.
 //!
 //! **Differential rendering support.** Every query first asks the real layer and then, in the
 //! pass *with* objects, the virtual layer; [`PathRecord::touched_virtual`] says whether a virtual
 //! triangle changed any answer (closer hit, or a blocked shadow ray). A path that never touched
 //! the virtual layer took exactly the same steps as it would without it, so the caller can reuse
-//! its value for the pass without objects, bit for bit.
+//! its value for the pass without objects, bit for bit. In the lights and hybrid modes a path
+//! that reaches its one diffuse or glossy vertex without a virtual closest hit also evaluates
+//! that vertex without the objects in the same walk ([`PathRecord::without_objects`]): each
+//! shadow and occlusion ray is open, blocked by the real layer (dark in both) or blocked by the
+//! virtual layer only (dark with the objects), so one set of rays gives both values, bit for bit
+//! what a second walk through the real layer alone would give (the same random numbers, the same
+//! sums in the same order). Only a path whose closest hit changed (the camera sees the object, or
+//! a mirror reflects it) is walked again.
 //!
-//! Cost per sample: O(bounces x (1 + lights at the first vertex) x log T) ray-BVH work.
+//! Cost per sample: reference O(bounces log T) ray-BVH work; lights O(N log T) for N lights,
+//! hybrid O((N + k) log T).
 
 use glam::Vec3;
 use ibl_core::Rgb;
 use ibl_scene::{Hit, Ray, Scene, ShadowKind, SurfacePoint};
 
-use crate::lighting::{Ambient, Illumination, LightList, Lighting};
+use crate::lighting::{Ambient, DirectionalLight, Illumination, LightList, Lighting};
 use crate::material::Bsdf;
-use crate::sampling::{OrthonormalBasis, PixelRng, power_heuristic, sample_cosine_hemisphere};
+use crate::sampler::SampleStream;
+use crate::sampling::{OrthonormalBasis, power_heuristic, sample_cosine_hemisphere};
 
 /// Which layers a path may meet.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -64,6 +82,72 @@ pub struct PathRecord {
     pub touched_virtual: bool,
     /// Rays traced (closest-hit and shadow queries).
     pub rays: u64,
+    /// The radiance of the same path without the objects, when this walk could tell it (the
+    /// lights and hybrid modes, for a path through [`Layers::WithObjects`] that met no virtual
+    /// surface): then no second walk is needed, even when [`PathRecord::touched_virtual`].
+    pub without_objects: Option<Rgb>,
+}
+
+/// Whether a ray towards a distant light is blocked, and by which layer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Occlusion {
+    /// Nothing blocks it.
+    Open,
+    /// The virtual objects block it, the real layer does not.
+    Virtual,
+    /// The real layer blocks it (with or without the objects).
+    Real,
+}
+
+/// A diffuse or glossy vertex being shaded.
+struct Vertex<'a> {
+    surface: &'a SurfacePoint,
+    bsdf: &'a Bsdf,
+    /// Unit direction towards the camera (the previous vertex).
+    wo: Vec3,
+}
+
+/// Light arriving at a vertex, with the objects and (when the walk can tell) without them.
+#[derive(Clone, Copy, Debug)]
+struct LayeredLight {
+    with: Rgb,
+    without: Option<Rgb>,
+}
+
+impl LayeredLight {
+    /// No light yet, in the layers a walk in `state` can evaluate at its vertex: without the
+    /// objects too while it goes through both layers and no virtual triangle has changed any of
+    /// its queries so far (decided once per vertex, before its shadow rays).
+    fn none(state: &PathState) -> LayeredLight {
+        LayeredLight {
+            with: Rgb::ZERO,
+            without: (state.layers == Layers::WithObjects && !state.touched_virtual)
+                .then_some(Rgb::ZERO),
+        }
+    }
+
+    /// Adds `value` to the layers in which a ray blocked as `occlusion` is open.
+    #[inline]
+    fn add(&mut self, occlusion: Occlusion, value: Rgb) {
+        if occlusion == Occlusion::Open {
+            self.with += value;
+        }
+        if let Some(without) = &mut self.without
+            && occlusion != Occlusion::Real
+        {
+            *without += value;
+        }
+    }
+}
+
+impl std::ops::Add for LayeredLight {
+    type Output = LayeredLight;
+    fn add(self, other: LayeredLight) -> LayeredLight {
+        LayeredLight {
+            with: self.with + other.with,
+            without: self.without.zip(other.without).map(|(a, b)| a + b),
+        }
+    }
 }
 
 /// Traces paths through one scene under one lighting.
@@ -71,8 +155,6 @@ pub struct Tracer<'a> {
     scene: &'a Scene,
     lighting: &'a Lighting,
     bounces: u32,
-    /// Offset of secondary ray origins along the geometric normal (scene-scaled).
-    epsilon: f32,
 }
 
 /// Vertex count from which Russian roulette may end a path.
@@ -86,23 +168,18 @@ struct PathState {
 }
 
 impl<'a> Tracer<'a> {
-    /// A tracer for `scene` lit by `lighting`, paths of at most `bounces` surface vertices.
+    /// A tracer for `scene` lit by `lighting`, paths of at most `bounces` surface vertices (the
+    /// lights and hybrid modes end at the first diffuse or glossy one).
     pub fn new(scene: &'a Scene, lighting: &'a Lighting, bounces: u32) -> Tracer<'a> {
-        let extent = [scene.real.bvh.bounds(), scene.virtual_objects.bvh.bounds()]
-            .into_iter()
-            .flatten()
-            .map(|(lo, hi)| lo.abs().max(hi.abs()).max_element())
-            .fold(scene.probe.position.abs().max_element(), f32::max);
         Tracer {
             scene,
             lighting,
             bounces: bounces.max(1),
-            epsilon: 1e-4 * extent.max(1.0),
         }
     }
 
-    /// Radiance along `ray` through `layers`, random numbers from `rng`.
-    pub fn trace(&self, ray: Ray, layers: Layers, rng: &mut PixelRng) -> PathRecord {
+    /// Radiance along `ray` through `layers`, random numbers from `stream`.
+    pub fn trace(&self, ray: Ray, layers: Layers, stream: &mut SampleStream) -> PathRecord {
         let mut state = PathState {
             layers,
             touched_virtual: false,
@@ -115,6 +192,7 @@ impl<'a> Tracer<'a> {
         // Density of the BSDF sample that made `ray` (None: camera ray or mirror).
         let mut bsdf_pdf: Option<f32> = None;
         let mut vertex = 0u32;
+        let mut without_objects = None;
         loop {
             let Some((surface, is_virtual)) = self.closest(&ray, &mut state) else {
                 radiance += throughput * self.escaped(ray.direction, bsdf_pdf);
@@ -138,38 +216,66 @@ impl<'a> Tracer<'a> {
                 surface.geometric_normal,
             );
             if !bsdf.is_delta() {
-                radiance += throughput * self.direct(&surface, &bsdf, wo, vertex, rng, &mut state);
-                if matches!(self.lighting.illumination, Illumination::Hybrid(..)) {
-                    break;
-                }
-                // At the last vertex only the reference continues: its escaping BSDF sample is
-                // the MIS partner of the environment sample. The lights stand for the rest.
-                if vertex >= self.bounces
-                    && !matches!(self.lighting.illumination, Illumination::Environment)
-                {
-                    break;
+                match &self.lighting.illumination {
+                    Illumination::Environment => {
+                        radiance += throughput
+                            * self.environment_sample(&surface, &bsdf, wo, stream, &mut state);
+                    }
+                    Illumination::Lights(list) => {
+                        let none = LayeredLight::none(&state);
+                        let vertex = Vertex {
+                            surface: &surface,
+                            bsdf: &bsdf,
+                            wo,
+                        };
+                        let direct = self.lights(list, &vertex, stream, &mut state, none);
+                        without_objects = direct
+                            .without
+                            .map(|w| radiance + throughput * w.map(|v| v.max(0.0)));
+                        radiance += throughput * direct.with.map(|v| v.max(0.0));
+                        break;
+                    }
+                    Illumination::Hybrid(list, ambient) => {
+                        let none = LayeredLight::none(&state);
+                        let vertex = Vertex {
+                            surface: &surface,
+                            bsdf: &bsdf,
+                            wo,
+                        };
+                        let direct = self.lights(list, &vertex, stream, &mut state, none)
+                            + self.ambient(ambient, &surface, stream, &mut state, none);
+                        without_objects = direct
+                            .without
+                            .map(|w| radiance + throughput * w.map(|v| v.max(0.0)));
+                        radiance += throughput * direct.with.map(|v| v.max(0.0));
+                        break;
+                    }
                 }
             }
-            let u = [rng.next_f32(), rng.next_f32(), rng.next_f32()];
-            let Some(sample) = bsdf.sample(wo, u) else {
+            // At the last vertex the reference still draws the BSDF sample: escaping, it is the
+            // MIS partner of the environment sample.
+            let lobe = stream.next_1d();
+            let [u1, u2] = stream.next_2d();
+            let Some(sample) = bsdf.sample(wo, [lobe, u1, u2]) else {
                 break;
             };
             throughput = throughput * sample.weight;
             bsdf_pdf = (!sample.is_delta).then_some(sample.pdf_sr);
             if vertex >= ROULETTE_FROM {
                 let survive = throughput.max_channel().min(0.95);
-                if survive <= 0.0 || rng.next_f32() >= survive {
+                if survive <= 0.0 || stream.next_1d() >= survive {
                     break;
                 }
                 throughput = throughput / survive;
             }
-            ray = Ray::new(self.offset(&surface, sample.wi), sample.wi);
+            ray = Ray::new(offset_origin(&surface, sample.wi), sample.wi);
         }
         PathRecord {
             radiance,
             primary,
             touched_virtual: state.touched_virtual,
             rays: state.rays,
+            without_objects,
         }
     }
 
@@ -183,28 +289,9 @@ impl<'a> Tracer<'a> {
             (Illumination::Environment, Some(pdf)) => {
                 env.radiance(direction) * power_heuristic(pdf, env.pdf(direction))
             }
-            // The lights (and the ambient) stand for the probe.
+            // The lights (and the ambient) stand for the probe; their paths end at the first
+            // diffuse or glossy vertex, so this arm is only reached by a BSDF sample there.
             (Illumination::Lights(_) | Illumination::Hybrid(..), Some(_)) => Rgb::ZERO,
-        }
-    }
-
-    /// Light arriving directly at a diffuse or glossy vertex and reflected towards `wo`.
-    fn direct(
-        &self,
-        surface: &SurfacePoint,
-        bsdf: &Bsdf,
-        wo: Vec3,
-        vertex: u32,
-        rng: &mut PixelRng,
-        state: &mut PathState,
-    ) -> Rgb {
-        match &self.lighting.illumination {
-            Illumination::Environment => self.environment_sample(surface, bsdf, wo, rng, state),
-            Illumination::Lights(list) => self.lights(list, surface, bsdf, wo, vertex, rng, state),
-            Illumination::Hybrid(list, ambient) => {
-                self.lights(list, surface, bsdf, wo, vertex, rng, state)
-                    + self.ambient(ambient, surface, rng, state)
-            }
         }
     }
 
@@ -214,134 +301,73 @@ impl<'a> Tracer<'a> {
         surface: &SurfacePoint,
         bsdf: &Bsdf,
         wo: Vec3,
-        rng: &mut PixelRng,
+        stream: &mut SampleStream,
         state: &mut PathState,
     ) -> Rgb {
         let env = &self.lighting.environment;
-        let sample = env.sample(rng.next_f32(), rng.next_f32());
+        let [u1, u2] = stream.next_2d();
+        let sample = env.sample(u1, u2);
         let wi = sample.direction;
         if sample.pdf_sr <= 0.0 {
             return Rgb::ZERO;
         }
-        let Some(f_cos) = self.unblocked_reflection(surface, bsdf, wo, wi, state) else {
+        let Some(f_cos) = reflection(surface, bsdf, wo, wi) else {
             return Rgb::ZERO;
         };
+        if self.occlusion(above(surface), wi, state) != Occlusion::Open {
+            return Rgb::ZERO;
+        }
         let weight = power_heuristic(sample.pdf_sr, bsdf.pdf(wo, wi));
         f_cos * sample.radiance * (weight / sample.pdf_sr)
     }
 
-    /// Directional lights: all of them at the first vertex, one chosen by power later.
-    #[allow(clippy::too_many_arguments)]
+    /// Every light, each with its own shadow ray (all from one origin above the surface: a
+    /// light below the geometric surface sends none).
     fn lights(
         &self,
         list: &LightList,
-        surface: &SurfacePoint,
-        bsdf: &Bsdf,
-        wo: Vec3,
-        vertex: u32,
-        rng: &mut PixelRng,
+        vertex: &Vertex,
+        stream: &mut SampleStream,
         state: &mut PathState,
-    ) -> Rgb {
-        if list.lights.is_empty() {
-            return Rgb::ZERO;
-        }
-        let mut sum = Rgb::ZERO;
-        if vertex == 1 {
-            for light in &list.lights {
-                sum += self.one_light(list.shadows, light, surface, bsdf, wo, rng, state);
+        mut sum: LayeredLight,
+    ) -> LayeredLight {
+        let origin = above(vertex.surface);
+        for light in &list.lights {
+            let wi = light_direction(list.shadows, light, stream);
+            if let Some(f_cos) = reflection(vertex.surface, vertex.bsdf, vertex.wo, wi) {
+                sum.add(self.occlusion(origin, wi, state), f_cos * light.irradiance);
             }
-        } else if let Some(choice) = list.choice.sample(rng.next_f32()) {
-            let light = &list.lights[choice.index];
-            sum += self.one_light(list.shadows, light, surface, bsdf, wo, rng, state)
-                / choice.probability;
         }
         sum
     }
 
-    #[allow(clippy::too_many_arguments)]
-    fn one_light(
-        &self,
-        shadows: ShadowKind,
-        light: &crate::lighting::DirectionalLight,
-        surface: &SurfacePoint,
-        bsdf: &Bsdf,
-        wo: Vec3,
-        rng: &mut PixelRng,
-        state: &mut PathState,
-    ) -> Rgb {
-        let wi = match (shadows, light.cone) {
-            (ShadowKind::Soft, Some(cone)) => {
-                let local = cone.sample(rng.next_f32(), rng.next_f32());
-                OrthonormalBasis::from_normal(light.direction).to_world(local)
-            }
-            _ => light.direction,
-        };
-        self.unblocked_reflection(surface, bsdf, wo, wi, state)
-            .map_or(Rgb::ZERO, |f_cos| f_cos * light.irradiance)
-    }
-
-    /// `f(wo, wi) cos(theta_i)` for light arriving from `wi`, or `None` when the surface cannot
-    /// reflect it (below the shading or geometric surface, a zero BSDF) or something blocks it.
-    fn unblocked_reflection(
-        &self,
-        surface: &SurfacePoint,
-        bsdf: &Bsdf,
-        wo: Vec3,
-        wi: Vec3,
-        state: &mut PathState,
-    ) -> Option<Rgb> {
-        let cos = surface.shading_normal.dot(wi);
-        if cos <= 0.0 || surface.geometric_normal.dot(wi) <= 0.0 {
-            return None;
-        }
-        let f = bsdf.eval(wo, wi);
-        if f.max_channel() <= 0.0 || self.occluded(surface, wi, state) {
-            return None;
-        }
-        Some(f * cos)
-    }
-
-    /// The hybrid ambient: `albedo / pi * E_ambient(n) * visibility`, visibility the fraction of
-    /// cosine-distributed rays that escape.
+    /// The hybrid ambient: `albedo * mean_k V(w_k) L_a(w_k)` over cosine-distributed `w_k`.
     fn ambient(
         &self,
         ambient: &Ambient,
         surface: &SurfacePoint,
-        rng: &mut PixelRng,
+        stream: &mut SampleStream,
         state: &mut PathState,
-    ) -> Rgb {
+        mut sum: LayeredLight,
+    ) -> LayeredLight {
         let albedo = surface.material.diffuse_albedo();
         if albedo.max_channel() <= 0.0 {
-            return Rgb::ZERO;
+            return sum;
         }
-        let e = ambient
-            .irradiance
-            .irradiance(surface.shading_normal.as_dvec3());
-        let irradiance = Rgb::new(
-            e[0].max(0.0) as f32,
-            e[1].max(0.0) as f32,
-            e[2].max(0.0) as f32,
-        );
         let basis = OrthonormalBasis::from_normal(surface.shading_normal);
-        let mut open = 0u32;
+        let origin = above(surface);
         for _ in 0..ambient.occlusion_rays {
-            let wi = basis.to_world(sample_cosine_hemisphere(rng.next_f32(), rng.next_f32()));
-            if surface.geometric_normal.dot(wi) > 0.0 && !self.occluded(surface, wi, state) {
-                open += 1;
+            let [u1, u2] = stream.next_2d();
+            let wi = basis.to_world(sample_cosine_hemisphere(u1, u2));
+            if surface.geometric_normal.dot(wi) > 0.0 {
+                sum.add(self.occlusion(origin, wi, state), ambient.radiance(wi));
             }
         }
-        let visibility = open as f32 / ambient.occlusion_rays as f32;
-        albedo * irradiance * (visibility / std::f32::consts::PI)
-    }
-
-    /// The origin of a ray leaving `surface` along `wi`, moved off the surface on `wi`'s side.
-    fn offset(&self, surface: &SurfacePoint, wi: Vec3) -> Vec3 {
-        let side = if surface.geometric_normal.dot(wi) >= 0.0 {
-            1.0
-        } else {
-            -1.0
-        };
-        surface.position + surface.geometric_normal * (side * self.epsilon)
+        let scale = |sum: Rgb| albedo * sum / ambient.occlusion_rays as f32;
+        LayeredLight {
+            with: scale(sum.with),
+            without: sum.without.map(scale),
+        }
     }
 
     /// Closest hit through the active layers; `true` when it is virtual.
@@ -352,30 +378,23 @@ impl<'a> Tracer<'a> {
             let limit = real.map_or(f32::INFINITY, |h: Hit| h.t);
             if let Some(hit) = self.scene.virtual_objects.bvh.closest_hit(ray, 0.0, limit) {
                 state.touched_virtual = true;
-                let surface =
-                    self.scene
-                        .virtual_objects
-                        .surface_point(&hit, ray.origin, ray.direction);
+                let surface = self
+                    .scene
+                    .virtual_objects
+                    .surface_point(&hit, ray.direction);
                 return Some((surface, true));
             }
         }
-        real.map(|hit| {
-            (
-                self.scene
-                    .real
-                    .surface_point(&hit, ray.origin, ray.direction),
-                false,
-            )
-        })
+        real.map(|hit| (self.scene.real.surface_point(&hit, ray.direction), false))
     }
 
-    /// Whether anything blocks the direction `wi` from `surface` (to infinity: the lights and
-    /// the environment are distant).
-    fn occluded(&self, surface: &SurfacePoint, wi: Vec3, state: &mut PathState) -> bool {
+    /// What blocks the direction `wi` from `origin` (a point just above a surface, [`above`]),
+    /// to infinity: the lights and the environment are distant.
+    fn occlusion(&self, origin: Vec3, wi: Vec3, state: &mut PathState) -> Occlusion {
         state.rays += 1;
-        let ray = Ray::new(self.offset(surface, wi), wi);
+        let ray = Ray::new(origin, wi);
         if self.scene.real.bvh.occluded(&ray, 0.0, f32::INFINITY) {
-            return true;
+            return Occlusion::Real;
         }
         if state.layers == Layers::WithObjects
             && self
@@ -385,8 +404,70 @@ impl<'a> Tracer<'a> {
                 .occluded(&ray, 0.0, f32::INFINITY)
         {
             state.touched_virtual = true;
-            return true;
+            return Occlusion::Virtual;
         }
-        false
+        Occlusion::Open
     }
+}
+
+/// `f(wo, wi) cos(theta_i)` for light arriving from `wi`, or `None` when the surface cannot
+/// reflect it (below the shading or geometric surface, or a zero BSDF).
+#[inline]
+fn reflection(surface: &SurfacePoint, bsdf: &Bsdf, wo: Vec3, wi: Vec3) -> Option<Rgb> {
+    let cos = surface.shading_normal.dot(wi);
+    if cos <= 0.0 || surface.geometric_normal.dot(wi) <= 0.0 {
+        return None;
+    }
+    let f = bsdf.eval(wo, wi);
+    (f.max_channel() > 0.0).then(|| f * cos)
+}
+
+/// The origin of every ray that leaves `surface` on its geometric normal's side (shadow and
+/// occlusion rays, which are only traced there): [`offset_origin`] along that normal.
+fn above(surface: &SurfacePoint) -> Vec3 {
+    offset_origin(surface, surface.geometric_normal)
+}
+
+/// The direction a light's shadow ray takes: its own (hard, or a point light) or a point of its
+/// cone from the stream's next pair (soft).
+fn light_direction(
+    shadows: ShadowKind,
+    light: &DirectionalLight,
+    stream: &mut SampleStream,
+) -> Vec3 {
+    match (shadows, light.cone) {
+        (ShadowKind::Soft, Some(cone)) => {
+            let [u1, u2] = stream.next_2d();
+            light.frame.to_world(cone.sample(u1, u2))
+        }
+        _ => light.direction,
+    }
+}
+
+/// The origin of a ray leaving `surface` along `wi`: the hit point moved along the geometric
+/// normal, to `wi`'s side, by `|n| . err`, then every coordinate rounded one ulp away from the
+/// surface (pbrt-v4 `OffsetRayOrigin`, section 6.8.6).
+pub fn offset_origin(surface: &SurfacePoint, wi: Vec3) -> Vec3 {
+    let n = surface.geometric_normal;
+    let distance = n.abs().dot(surface.position_error);
+    let offset = if n.dot(wi) >= 0.0 {
+        n * distance
+    } else {
+        n * -distance
+    };
+    let p = surface.position + offset;
+    let away = |p: f32, o: f32| {
+        if o > 0.0 {
+            p.next_up()
+        } else if o < 0.0 {
+            p.next_down()
+        } else {
+            p
+        }
+    };
+    Vec3::new(
+        away(p.x, offset.x),
+        away(p.y, offset.y),
+        away(p.z, offset.z),
+    )
 }

@@ -23,7 +23,7 @@ use ibl_core::{Image, Rgb};
 use ibl_extract::{Hybrid, median_cut};
 use ibl_light::{Extraction, Light, LightSet, Provenance};
 use ibl_metrics::ImageDifference;
-use ibl_render::{Lighting, RenderError, RenderOutput, RenderSettings, render};
+use ibl_render::{Lighting, RenderError, RenderOutput, RenderSettings, SamplerKind, render};
 use ibl_scene::description::CompositeRule;
 use ibl_scene::{RenderMode, Scene, SceneDescription, ShadowKind};
 
@@ -66,6 +66,7 @@ fn settings(spp: u32, bounces: u32, seed: u64, composite: CompositeRule) -> Rend
         spp,
         bounces,
         seed,
+        sampler: SamplerKind::Sobol,
     }
 }
 
@@ -97,14 +98,7 @@ impl Plan {
             Lighting::lights(scene, &set, self.shadows)?
         } else {
             let hybrid = Hybrid::from_probe(probe, set.clone(), 3, ibl_sh::Window::None).unwrap();
-            Lighting::hybrid(
-                scene,
-                &hybrid.lights,
-                &hybrid.ambient,
-                ibl_sh::Window::None,
-                self.shadows,
-                4,
-            )?
+            Lighting::hybrid(scene, &hybrid.lights, &hybrid.ambient, self.shadows, 4)?
         };
         Ok((lighting, Some(set)))
     }
@@ -904,7 +898,11 @@ fn a_mirror_sphere_reflects_the_environment_in_every_mode() {
     // Closed form: a convex mirror of reflectance R in a constant environment L shows R L at every
     // pixel it covers (each reflected ray escapes; the mirror is a delta lobe, so no sampling
     // noise). Every mode sends mirror rays to the probe itself, so lights and hybrid agree with
-    // the reference exactly there. Pixels the sphere only partly covers mix R L and L.
+    // the reference exactly there. Pixels the sphere only partly covers mix R L and L. Checked
+    // where the view meets the sphere at cos(theta_o) > 0.3: closer to grazing, the reflection
+    // about the interpolated shading normal can cross into the neighbouring facet of the
+    // tessellated sphere and hit it (a real hit on the faceted mirror; the former offset of
+    // 1e-4 of the scene's extent, 4e-4 here, lifted most such rays over the neighbour).
     let l = Rgb::new(0.75, 0.5, 0.25);
     let scene = furnace_scene(l, r#"{ kind = "mirror", specular = [0.5, 0.25, 1.0] }"#);
     let expected = Rgb::new(0.5 * 0.75, 0.25 * 0.5, 0.25);
@@ -917,21 +915,44 @@ fn a_mirror_sphere_reflects_the_environment_in_every_mode() {
         .build(&scene)
         .unwrap()
         .0;
-    for lighting in [reference, lights, hybrid] {
+    for (mode, lighting) in [
+        ("reference", reference),
+        ("lights", lights),
+        ("hybrid", hybrid),
+    ] {
         let out = run(
             &scene,
             &lighting,
             &settings(4, 4, 3, CompositeRule::Difference),
         );
         let mut covered = 0;
-        for (p, c) in pixels_and_coverage(&out) {
-            if c == 1.0 {
+        let (w, h) = (out.with_objects.width(), out.with_objects.height());
+        for (k, (p, c)) in pixels_and_coverage(&out).enumerate() {
+            if c == 1.0 && centre_ray_incidence(&scene, k % w, k / w, w, h) > 0.3 {
                 covered += 1;
                 for k in 0..3 {
-                    assert!((p[k] - expected[k]).abs() < 1e-6, "{p:?} vs {expected:?}");
+                    assert!(
+                        (p[k] - expected[k]).abs() < 1e-6,
+                        "{mode}: {p:?} vs {expected:?}"
+                    );
                 }
             }
         }
-        assert!(covered > 700, "{covered} mirror pixels");
+        assert!(covered > 600, "{covered} mirror pixels");
     }
+}
+
+/// `cos(theta_o)` where the centre ray of pixel `(x, y)` meets the exact unit sphere at the
+/// origin (0 when it misses).
+fn centre_ray_incidence(scene: &Scene, x: usize, y: usize, w: usize, h: usize) -> f64 {
+    let ray = scene
+        .camera
+        .ray(x as f32 + 0.5, y as f32 + 0.5, w as u32, h as u32);
+    let (o, d) = (ray.origin.as_dvec3(), ray.direction.as_dvec3());
+    let b = o.dot(d);
+    let disc = b * b - (o.length_squared() - 1.0);
+    if disc < 0.0 {
+        return 0.0;
+    }
+    (-d.dot(o + d * (-b - disc.sqrt()))).clamp(0.0, 1.0)
 }

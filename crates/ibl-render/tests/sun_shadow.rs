@@ -42,7 +42,7 @@ use glam::DVec3;
 use ibl_core::{Image, LatLong, Rgb};
 use ibl_extract::{ExtractOptions, ModelSpec, build_model};
 use ibl_light::LightSet;
-use ibl_render::{Lighting, RenderOutput, RenderSettings, render};
+use ibl_render::{Lighting, RenderOutput, RenderSettings, SamplerKind, render};
 use ibl_scene::description::CompositeRule;
 use ibl_scene::{Scene, SceneDescription, ShadowKind};
 
@@ -214,6 +214,7 @@ fn settings(spp: u32, seed: u64) -> RenderSettings {
         spp,
         bounces: 1,
         seed,
+        sampler: SamplerKind::Sobol,
     }
 }
 

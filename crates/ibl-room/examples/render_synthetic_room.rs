@@ -69,6 +69,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             spp: half,
             bounces: 64,
             seed,
+            sampler: ibl_render::SamplerKind::Sobol,
         };
         let out = render(&scene, &lighting, &settings, &|done, total| {
             if done % 64 == 0 || done == total {

@@ -15,7 +15,7 @@
 use std::path::{Path, PathBuf};
 
 use glam::{Vec2, Vec3};
-use ibl_io::tonemap::{Display, ToneCurve, auto_exposure_stops, to_srgb8};
+use ibl_core::tonemap::{Display, ToneCurve, auto_exposure_stops, to_srgb8};
 use ibl_room::picture::{reflectance_cutaway, reflectance_panorama, room_overlay};
 use ibl_room::{
     AnalysisSettings, ManhattanSettings, MarksFile, Room, RoomFile, RoomReport, analyse_room,

@@ -13,7 +13,7 @@
 use std::path::PathBuf;
 
 use ibl_core::Image;
-use ibl_io::tonemap::{Display, ToneCurve, auto_exposure_stops, to_srgb8};
+use ibl_core::tonemap::{Display, ToneCurve, auto_exposure_stops, to_srgb8};
 use ibl_room::marks::Axis;
 use ibl_room::{MarksFile, PerspectiveView};
 

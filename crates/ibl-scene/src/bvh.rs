@@ -37,7 +37,11 @@
 //! they share a sign (either sign: both faces), `t = (U A_z + V B_z + W C_z) / (U + V + W)`.
 //! Neighbours compute their shared edge function from the same floats, so a ray through a shared
 //! edge or corner always hits at least one of them. The dominant axis is a const generic: one
-//! branch per ray, none per triangle.
+//! branch per ray, none per triangle. A hit is reported only when `t` exceeds its own
+//! conservative rounding-error bound `delta_t` (Pharr, Jakob and Humphreys, *Physically Based
+//! Rendering*, 4th ed., section 6.8.4): a ray leaving a surface from an origin offset by that
+//! surface's hit-point error bound can then never hit the surface again, however large the
+//! triangle, and `t_min = 0` is the right lower limit for such rays.
 //!
 //! **Traversal**: near child first with an explicit 64-entry stack (no allocation per query);
 //! popped subtrees farther than the best hit are skipped. Closest-hit ties (equal `t`) go to the
@@ -46,7 +50,7 @@
 
 use glam::{Vec3, Vec3A, Vec4, Vec4Swizzles};
 
-use crate::ray::{Hit, Ray};
+use crate::ray::{Hit, Ray, gamma};
 
 /// Centroid bins per axis in the SAH sweep.
 const BINS: usize = 16;
@@ -372,12 +376,29 @@ impl Bvh {
         t_min: f32,
         t_max: f32,
     ) -> bool {
-        let tri_ray = TriangleRay::<KX, KY, KZ>::new(ray);
         let box_ray = BoxRay::new(ray, t_min);
         let cull = widen(t_max);
+        let mut node = self.root;
+        // Early outs before the triangle ray and the traversal stack (zeroed, 512 bytes) are
+        // made: most shadow rays miss both of the root's children (the rays from a floor past a
+        // small object), and a root leaf (a ground plane's two triangles) is tested directly.
+        if node.count == 0 && box_ray.test(&self.pairs[node.child as usize], cull).0 == 0 {
+            return false;
+        }
+        let tri_ray = TriangleRay::<KX, KY, KZ>::new(ray);
+        let hits = |tri: &[f32; 9]| {
+            tri_ray
+                .intersect(tri)
+                .is_some_and(|h| h.t > t_min && h.t < t_max)
+        };
+        if node.count > 0 {
+            let first = node.child as usize;
+            return self.triangles[first..first + node.count as usize]
+                .iter()
+                .any(hits);
+        }
         let mut stack = [NodeRef::default(); STACK_SIZE];
         let mut sp = 0;
-        let mut node = self.root;
         loop {
             if node.count == 0 {
                 let pair = &self.pairs[node.child as usize];
@@ -401,13 +422,11 @@ impl Bvh {
                 continue;
             }
             let first = node.child as usize;
-            for tri in &self.triangles[first..first + node.count as usize] {
-                if let Some(h) = tri_ray.intersect(tri)
-                    && h.t > t_min
-                    && h.t < t_max
-                {
-                    return true;
-                }
+            if self.triangles[first..first + node.count as usize]
+                .iter()
+                .any(hits)
+            {
+                return true;
             }
             if sp == 0 {
                 return false;
@@ -696,7 +715,8 @@ impl<const KX: usize, const KY: usize, const KZ: usize> TriangleRay<KX, KY, KZ> 
         }
     }
 
-    /// The two-sided watertight test; `None` on a miss, otherwise `t` along the ray (any sign).
+    /// The two-sided watertight test; `None` on a miss or when `t` is not certainly positive
+    /// (at most its rounding-error bound), otherwise `t` along the ray.
     #[inline(always)]
     fn intersect(&self, tri: &[f32; 9]) -> Option<TriangleHit> {
         let o = &self.origin;
@@ -729,7 +749,26 @@ impl<const KX: usize, const KY: usize, const KZ: usize> TriangleRay<KX, KY, KZ> 
             return None;
         }
         let t = sz * (u * az + v * bz + w * cz) / det;
-        Some(TriangleHit { t, v, w, det })
+        // Behind the origin (a shadow ray's own surface, most often): no hit whatever the bound.
+        if t <= 0.0 || t.is_nan() {
+            return None;
+        }
+        // Only hits certainly in front of the origin: `t` above its own rounding-error bound
+        // (pbrt-v4 section 6.8.4, in this test's variables, with the shear terms weighted by the
+        // shear factors, which pbrt bounds by 1).
+        let max_z = az.abs().max(bz.abs()).max(cz.abs());
+        let max_zt = sz.abs() * max_z;
+        let max_x = ax.abs().max(bx.abs()).max(cx.abs());
+        let max_y = ay.abs().max(by.abs()).max(cy.abs());
+        let delta_x = gamma(5) * (max_x + sx.abs() * max_z);
+        let delta_y = gamma(5) * (max_y + sy.abs() * max_z);
+        let delta_e = 2.0 * (gamma(2) * max_x * max_y + delta_y * max_x + delta_x * max_y);
+        let max_e = u.abs().max(v.abs()).max(w.abs());
+        let delta_t = 3.0
+            * (gamma(3) * max_e * max_zt + delta_e * max_zt + gamma(3) * max_zt * max_e)
+            / det.abs();
+        // NaN `t` (a degenerate triangle) is no hit either.
+        (t > delta_t).then_some(TriangleHit { t, v, w, det })
     }
 }
 

@@ -26,7 +26,9 @@ pub mod scene;
 
 pub use bvh::Bvh;
 pub use camera::Camera;
-pub use description::{DescriptionError, FORMAT_VERSION, RenderMode, SceneDescription, ShadowKind};
+pub use description::{
+    DescriptionError, FORMAT_VERSION, RenderMode, SamplerKind, SceneDescription, ShadowKind,
+};
 pub use material::Material;
 pub use mesh::{MeshError, TriangleMesh};
 pub use patch::PatchAttributes;

@@ -1,5 +1,6 @@
 //! Rays and ray hits in the world frame (`docs/CONVENTIONS.md` section 1: +Y up, -Z forward, metres
-//! or any consistent length unit).
+//! or any consistent length unit), and the f32 rounding-error constant `gamma_n` the intersection
+//! and hit-point error bounds are written in.
 
 use glam::Vec3;
 
@@ -35,4 +36,12 @@ pub struct Hit {
     pub u: f32,
     /// Barycentric coordinate of the triangle's third vertex (the first has `1 - u - v`).
     pub v: f32,
+}
+
+/// `gamma_n = n u / (1 - n u)` with `u = 2^-24` (f32 unit roundoff): a bound on the relative error
+/// of `n` successive f32 roundings (Higham 2002, section 3.1; Pharr, Jakob and Humphreys,
+/// *Physically Based Rendering*, 4th ed., section 6.8.1).
+pub const fn gamma(n: u32) -> f32 {
+    let nu = n as f32 * (f32::EPSILON * 0.5);
+    nu / (1.0 - nu)
 }

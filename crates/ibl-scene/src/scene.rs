@@ -14,6 +14,7 @@ use crate::description::{
     SceneDescription, ShapeKind,
 };
 use crate::patch::PatchAttributes;
+use crate::ray::gamma;
 use crate::{Bvh, Camera, Hit, Material, TriangleMesh, primitives};
 
 /// Icosphere subdivisions of a `sphere` shape (20480 triangles).
@@ -35,8 +36,12 @@ pub struct SurfaceTriangle {
 /// The shading frame at a hit.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SurfacePoint {
-    /// Hit position, world frame.
+    /// Hit position, world frame: the barycentric interpolation of the triangle's corners.
     pub position: Vec3,
+    /// Per axis, a bound on the rounding error of `position` (world units): the computed point
+    /// lies within this box of the exact point on the triangle (see
+    /// [`GeometryLayer::surface_point`]).
+    pub position_error: Vec3,
     /// Unit shading normal (interpolated), on the same side as `geometric_normal`.
     pub shading_normal: Vec3,
     /// Unit geometric normal, facing the incoming ray's origin.
@@ -218,9 +223,20 @@ impl GeometryLayer {
     /// The shading frame of `hit` for a ray travelling along `direction`: normals flipped to face
     /// the ray's origin (surfaces are two-sided), the shading normal bent back to the geometric
     /// side if interpolation pushed it over.
-    pub fn surface_point(&self, hit: &Hit, origin: Vec3, direction: Vec3) -> SurfacePoint {
+    ///
+    /// The position is interpolated from the corners, `p = b0 p0 + b1 p1 + b2 p2`, not taken
+    /// along the ray (`o + t d` carries the error of `t`, which grows with the distance travelled).
+    /// Its rounding error is bounded per axis by `gamma_7 (|b0 p0| + |b1 p1| + |b2 p2|)` with
+    /// `gamma_n = n u / (1 - n u)`, `u = 2^-24` (Pharr, Jakob and Humphreys, *Physically Based
+    /// Rendering*, 4th ed., section 6.8.5): it depends on where the triangle is, never on the
+    /// size of the rest of the scene.
+    pub fn surface_point(&self, hit: &Hit, direction: Vec3) -> SurfacePoint {
         let s = &self.surfaces[hit.triangle as usize];
         let w = 1.0 - hit.u - hit.v;
+        let [p0, p1, p2] = self.triangles[hit.triangle as usize];
+        let (a, b, c) = (p0 * w, p1 * hit.u, p2 * hit.v);
+        let position = a + b + c;
+        let position_error = (a.abs() + b.abs() + c.abs()) * gamma(7);
         let mut shading = (s.normals[0] * w + s.normals[1] * hit.u + s.normals[2] * hit.v)
             .normalize_or(s.geometric_normal);
         let mut geometric = s.geometric_normal;
@@ -232,7 +248,8 @@ impl GeometryLayer {
             shading = geometric;
         }
         SurfacePoint {
-            position: origin + direction * hit.t,
+            position,
+            position_error,
             shading_normal: shading,
             geometric_normal: geometric,
             material: self.materials[s.material as usize],

@@ -8,6 +8,7 @@ use ibl_light::{LightSource, Method};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 use super::field::{DescriptionError, invalid};
+use super::render::MAX_SPP;
 
 /// `[lighting]`: the approximation used by the `lights` and `hybrid` modes.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -25,13 +26,17 @@ pub struct LightingDescription {
     pub lights: u32,
     /// A light file (`ibl lights` JSON) to use instead of extracting, relative to the scene file.
     pub lights_file: Option<PathBuf>,
-    /// `hard` or `soft` (each light a cone of its own solid angle). Default `hard`.
+    /// `hard` or `soft` (each light a cone of its own solid angle). Default `soft`.
     #[serde(default)]
     pub shadows: ShadowKind,
+    /// Samples per pixel of the `lights` and `hybrid` modes (antialiasing; each sample evaluates
+    /// every light once, its soft-shadow cone stratified across the samples). Default 4.
+    #[serde(default = "default_lights_spp")]
+    pub spp: u32,
     /// SH bands of the hybrid ambient. Default 3.
     #[serde(default = "default_bands")]
     pub ambient_bands: u32,
-    /// Ambient-occlusion rays per shading point (hybrid). Default 16.
+    /// Occlusion rays per shading point and sample (hybrid). Default 4.
     #[serde(default = "default_ao")]
     pub ao_samples: u32,
 }
@@ -51,11 +56,14 @@ fn method_from_name<'de, D: Deserializer<'de>>(d: D) -> Result<LightSource, D::E
 fn default_lights() -> u32 {
     16
 }
+fn default_lights_spp() -> u32 {
+    4
+}
 fn default_bands() -> u32 {
     3
 }
 fn default_ao() -> u32 {
-    16
+    4
 }
 
 impl Default for LightingDescription {
@@ -65,6 +73,7 @@ impl Default for LightingDescription {
             lights: default_lights(),
             lights_file: None,
             shadows: ShadowKind::default(),
+            spp: default_lights_spp(),
             ambient_bands: default_bands(),
             ao_samples: default_ao(),
         }
@@ -76,9 +85,9 @@ impl Default for LightingDescription {
 #[serde(rename_all = "lowercase")]
 pub enum ShadowKind {
     /// One shadow ray towards each light's direction.
-    #[default]
     Hard,
     /// Shadow rays spread over a cone of the light's own solid angle.
+    #[default]
     Soft,
 }
 
@@ -99,6 +108,12 @@ impl LightingDescription {
             return Err(invalid(
                 "lighting.lights",
                 format!("{} is not in 1..=4096", self.lights),
+            ));
+        }
+        if !(1..=MAX_SPP).contains(&self.spp) {
+            return Err(invalid(
+                "lighting.spp",
+                format!("{} is not in 1..={MAX_SPP}", self.spp),
             ));
         }
         if !(1..=16).contains(&self.ambient_bands) {

@@ -42,7 +42,9 @@ pub use material::{
     MaterialKind,
 };
 pub use probe::ProbeDescription;
-pub use render::{CompositeRule, MAX_BOUNCES, MAX_SPP, MAX_WIDTH, RenderDescription, RenderMode};
+pub use render::{
+    CompositeRule, MAX_BOUNCES, MAX_SPP, MAX_WIDTH, RenderDescription, RenderMode, SamplerKind,
+};
 
 /// The only format version this build reads.
 pub const FORMAT_VERSION: u32 = 1;

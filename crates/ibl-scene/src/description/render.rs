@@ -1,5 +1,5 @@
-//! `[render]`: the renderer's settings (mode, size, samples, bounces, seed, composite rule); the
-//! command line overrides them. Limits on each setting are here.
+//! `[render]`: the renderer's settings (mode, size, samples, bounces, seed, composite rule,
+//! sampler); the command line overrides them. Limits on each setting are here.
 
 use serde::{Deserialize, Serialize};
 
@@ -26,6 +26,31 @@ pub struct RenderDescription {
     /// How the objects' effect on real surfaces is composited. Default `difference`.
     #[serde(default)]
     pub composite: CompositeRule,
+    /// Which random numbers the samples draw. Default `sobol`.
+    #[serde(default)]
+    pub sampler: SamplerKind,
+}
+
+/// Which random numbers a render's samples draw (every mode).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SamplerKind {
+    /// Owen-scrambled Sobol points (low discrepancy): each pair of numbers a sample draws is
+    /// stratified across the pixel's samples.
+    #[default]
+    Sobol,
+    /// Independent uniform numbers (PCG32).
+    Independent,
+}
+
+impl SamplerKind {
+    /// The name used in files and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            SamplerKind::Sobol => "sobol",
+            SamplerKind::Independent => "independent",
+        }
+    }
 }
 
 /// How differential rendering adds the objects' effect on real surfaces to the background `B`.
@@ -71,6 +96,7 @@ impl Default for RenderDescription {
             bounces: default_bounces(),
             seed: default_seed(),
             composite: CompositeRule::default(),
+            sampler: SamplerKind::default(),
         }
     }
 }
