@@ -1,0 +1,351 @@
+//! Refreshing an irradiance volume from the frame's lighting, two ways (Jensen, Andersen & Madsen
+//! 2006, sections 3.3 and 6).
+//!
+//! **Offline** (the paper's pre-calculation, "which pixels of the environment map are used in
+//! which key point"): from every key point of an [`IrradianceVolume`] grid, rays through the
+//! pixel centres of a small lat-long (default 32 x 16) are cast into the model. A ray that meets
+//! a surface takes the probe pixel in the direction of that point from the probe centre (the
+//! probe mapped onto the model, as the paper does); one that leaves the scene above the horizon
+//! sees the sky model directly (the same in every position); below the horizon, nothing. Each
+//! direction `w` of solid angle `dOmega` adds `Y_k(w) dOmega A_l` (Lambert factor of its band) to
+//! its pixel's weights for SH coefficient `k`: L2 irradiance is linear in the pixels. A key point
+//! from which more than a quarter of the rays meet back faces is inside something and invalid.
+//!
+//! **(a) From the relit map** ([`MapGather::refresh`]): `E_k = sum_pixels L_relit w_k + P_a
+//! sky_k`, with `sky_k = sum_{sky rays} shape(w) Y_k dOmega A_l` re-made when the sky shape
+//! changes. Cost O(key points x distinct pixels x 27) per frame.
+//!
+//! **(b) Relighting the key points directly** ([`KeyPointRelighter`], the optimisation the
+//! paper suggests): the relit pixel is linear in the two estimates, `L = a P_a + b P_d` with `a =
+//! d c_shape` (or the sky shape, or `L_probe / P_a,0` for pixels without albedo) and `b = d s
+//! max(0, n . l)`, so each key point's irradiance is `E = P_a A + P_d B` with two fixed RGB SH
+//! sets `A`, `B` gathered once per sun move (shadow or shape change). Per frame that is 54
+//! multiply-adds per key point, whatever the map size; it equals (a) up to rounding.
+
+use glam::Vec3;
+use ibl_core::{Image, LatLong, Rgb};
+use ibl_scene::{GeometryLayer, Ray};
+use ibl_sh::{
+    IrradianceL2, IrradianceVolume, VolumeGrid, VolumeLayer, VolumeLayers, eval_basis,
+    lambert_factor,
+};
+use rayon::prelude::*;
+
+use crate::OutdoorError;
+use crate::maps::ProbeMaps;
+use crate::relight::Relighter;
+use crate::tracking::SkyTracker;
+
+/// L2 weights of one direction or pixel: `Y_k(w) dOmega A_l`.
+type Weights = [f32; 9];
+
+/// One key point's gather list.
+#[derive(Clone, Debug, Default)]
+struct KeyGather {
+    /// `(row-major probe pixel, weights)`, one entry per distinct pixel.
+    pixels: Vec<(u32, Weights)>,
+    /// Directions that see the sky, with their weights.
+    sky: Vec<(Vec3, Weights)>,
+}
+
+/// The precomputed pixel-to-key-point weights.
+#[derive(Clone, Debug)]
+pub struct MapGather {
+    grid: VolumeGrid,
+    valid: Vec<bool>,
+    keys: Vec<KeyGather>,
+    /// Per key point, `sum_{sky rays} shape(w) w_k` (RGB per coefficient).
+    sky_parts: Vec<IrradianceL2>,
+    sky_generation: u64,
+    directions: usize,
+}
+
+fn weights(w: Vec3, d_omega: f32) -> Weights {
+    let mut y = [0.0f64; 9];
+    eval_basis(w.as_dvec3(), 3, &mut y);
+    let mut out = [0.0f32; 9];
+    for (k, o) in out.iter_mut().enumerate() {
+        let l = if k == 0 { 0 } else if k < 4 { 1 } else { 2 };
+        *o = (y[k] * lambert_factor(l)) as f32 * d_omega;
+    }
+    out
+}
+
+impl MapGather {
+    /// Casts `width x width/2` rays from every key point of `grid` into `layer` and maps them to
+    /// the pixels of `maps`' probe.
+    pub fn new(
+        layer: &GeometryLayer,
+        maps: &ProbeMaps,
+        grid: VolumeGrid,
+        width: usize,
+    ) -> Result<MapGather, OutdoorError> {
+        if !(4..=512).contains(&width) {
+            return Err(OutdoorError::Parameter(format!(
+                "key-point map width must be 4 to 512; got {width}"
+            )));
+        }
+        let height = width / 2;
+        let dirs = LatLong::new(width, height);
+        let solid: Vec<f32> = dirs.row_solid_angles().iter().map(|&v| v as f32).collect();
+        let projection = maps.projection();
+        let (pw, _) = maps.size();
+        let per_key: Vec<(bool, KeyGather)> = (0..grid.len())
+            .into_par_iter()
+            .map(|index| {
+                let origin = grid.position(index).as_vec3();
+                let mut pixels: std::collections::BTreeMap<u32, Weights> = Default::default();
+                let mut sky = Vec::new();
+                let mut back = 0usize;
+                for j in 0..height {
+                    for i in 0..width {
+                        let w = dirs.pixel_dir(i, j);
+                        let wts = weights(w, solid[j]);
+                        let ray = Ray::new(origin, w);
+                        match layer.bvh.closest_hit(&ray, 0.0, f32::INFINITY) {
+                            Some(hit) => {
+                                let s = &layer.surfaces[hit.triangle as usize];
+                                if s.geometric_normal.dot(w) > 0.0 {
+                                    back += 1;
+                                }
+                                let point = ray.at(hit.t);
+                                let d = (point - projection.position).normalize_or(Vec3::Y);
+                                let (pi, pj) = projection.pixel_towards(d);
+                                let entry = pixels.entry((pj * pw + pi) as u32).or_insert([0.0; 9]);
+                                for (e, v) in entry.iter_mut().zip(wts) {
+                                    *e += v;
+                                }
+                            }
+                            None if w.y > 0.0 => sky.push((w, wts)),
+                            None => {}
+                        }
+                    }
+                }
+                let valid = back * 4 <= width * height;
+                (
+                    valid,
+                    KeyGather {
+                        pixels: pixels.into_iter().collect(),
+                        sky,
+                    },
+                )
+            })
+            .collect();
+        let valid = per_key.iter().map(|k| k.0).collect();
+        let keys = per_key.into_iter().map(|k| k.1).collect();
+        Ok(MapGather {
+            grid,
+            valid,
+            keys,
+            sky_parts: vec![IrradianceL2::ZERO; grid.len()],
+            sky_generation: 0,
+            directions: width * height,
+        })
+    }
+
+    /// A volume for this grid with the validity found (one layer, zero irradiance).
+    pub fn empty_volume(&self) -> IrradianceVolume {
+        let mut v = IrradianceVolume::new(self.grid, VolumeLayers::AllLight);
+        for (i, &ok) in self.valid.iter().enumerate() {
+            v.set_valid(i, ok);
+        }
+        v
+    }
+
+    /// Rays cast per key point.
+    pub fn directions(&self) -> usize {
+        self.directions
+    }
+
+    /// Distinct probe pixels gathered, over all key points.
+    pub fn entries(&self) -> usize {
+        self.keys.iter().map(|k| k.pixels.len()).sum()
+    }
+
+    fn update_sky(&mut self, sky: &SkyTracker) -> Result<(), OutdoorError> {
+        if self.sky_generation == sky.generation() {
+            return Ok(());
+        }
+        let shape = sky.shape()?;
+        self.sky_parts = self
+            .keys
+            .par_iter()
+            .map(|k| {
+                let mut out = IrradianceL2::ZERO;
+                for (w, wts) in &k.sky {
+                    let l = shape.radiance(*w).to_array();
+                    for (c, v) in out.coefficients.iter_mut().zip(wts) {
+                        for ch in 0..3 {
+                            c[ch] += l[ch] * v;
+                        }
+                    }
+                }
+                out
+            })
+            .collect();
+        self.sky_generation = sky.generation();
+        Ok(())
+    }
+
+    /// (a): writes every key point's irradiance from the relit map `relit` and `P_a = sky`.
+    pub fn refresh(
+        &mut self,
+        relit: &Image<Rgb>,
+        sky_tracker: &SkyTracker,
+        sky: Rgb,
+        volume: &mut IrradianceVolume,
+    ) -> Result<(), OutdoorError> {
+        self.update_sky(sky_tracker)?;
+        if volume.grid() != &self.grid {
+            return Err(OutdoorError::Parameter(
+                "the volume's grid is not the one the weights were made for".into(),
+            ));
+        }
+        let pixels = relit.pixels();
+        let pa = sky.to_array();
+        let out = volume
+            .layer_mut(VolumeLayer::AllLight)
+            .map_err(|e| OutdoorError::Parameter(e.to_string()))?;
+        out.par_iter_mut()
+            .zip(self.keys.par_iter().zip(&self.sky_parts))
+            .for_each(|(o, (key, sky_part))| {
+                let mut acc = [[0.0f32; 3]; 9];
+                for (p, wts) in &key.pixels {
+                    let l = pixels[*p as usize].to_array();
+                    for (a, v) in acc.iter_mut().zip(wts) {
+                        a[0] += l[0] * v;
+                        a[1] += l[1] * v;
+                        a[2] += l[2] * v;
+                    }
+                }
+                for (a, s) in acc.iter_mut().zip(&sky_part.coefficients) {
+                    for ch in 0..3 {
+                        a[ch] += pa[ch] * s[ch];
+                    }
+                }
+                o.coefficients = acc;
+            });
+        Ok(())
+    }
+}
+
+/// (b): each key point's irradiance as `P_a A + P_d B` (see the module doc).
+#[derive(Clone, Debug)]
+pub struct KeyPointRelighter {
+    sky_response: Vec<IrradianceL2>,
+    sun_response: Vec<IrradianceL2>,
+    /// The relighter state the responses were gathered for: (sky generation, shadow casts, sun).
+    made_for: Option<(u64, u32, Vec3)>,
+}
+
+impl Default for KeyPointRelighter {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl KeyPointRelighter {
+    /// No responses yet.
+    pub fn new() -> KeyPointRelighter {
+        KeyPointRelighter {
+            sky_response: Vec::new(),
+            sun_response: Vec::new(),
+            made_for: None,
+        }
+    }
+
+    /// Re-gathers the responses when the relighter's shadows or sky shape changed, or the sun
+    /// moved (its cosine); returns whether it did. `relighter` must be updated for `sun`.
+    pub fn update(
+        &mut self,
+        gather: &mut MapGather,
+        maps: &ProbeMaps,
+        relighter: &Relighter,
+        sky: &SkyTracker,
+        sun: Vec3,
+    ) -> Result<bool, OutdoorError> {
+        let state = (sky.generation(), relighter.lighting().shadow().casts(), sun);
+        if self.made_for == Some(state) {
+            return Ok(false);
+        }
+        gather.update_sky(sky)?;
+        let (w, h) = maps.size();
+        let capture_sky = Rgb::from_array(maps.capture().sky);
+        let lighting = relighter.lighting();
+        let terms = lighting.sky_terms();
+        let points = maps.points();
+        let albedo = maps.albedo();
+        let probe = maps.probe().pixels();
+        let sky_pixels = relighter.sky_pixels();
+        if sky_pixels.len() != w * h || terms.len() != points.len() {
+            return Err(OutdoorError::Parameter(
+                "the relighter was not updated for these maps".into(),
+            ));
+        }
+        // Per pixel: the response to unit P_a and to unit P_d.
+        let response = |p: usize| -> (Rgb, Rgb) {
+            match maps.point_of_pixel(p) {
+                None => (sky_pixels[p], Rgb::ZERO),
+                Some(k) => match albedo[k] {
+                    Some(d) => (
+                        d * terms[k],
+                        d * lighting.sun_term(k, points[k].normal, sun),
+                    ),
+                    None => (
+                        Rgb::new(
+                            probe[p].r / capture_sky.r.max(1e-30),
+                            probe[p].g / capture_sky.g.max(1e-30),
+                            probe[p].b / capture_sky.b.max(1e-30),
+                        ),
+                        Rgb::ZERO,
+                    ),
+                },
+            }
+        };
+        let gathered: Vec<(IrradianceL2, IrradianceL2)> = gather
+            .keys
+            .par_iter()
+            .zip(&gather.sky_parts)
+            .map(|(key, sky_part)| {
+                let mut a = *sky_part;
+                let mut b = IrradianceL2::ZERO;
+                for (p, wts) in &key.pixels {
+                    let (ra, rb) = response(*p as usize);
+                    let (ra, rb) = (ra.to_array(), rb.to_array());
+                    for (k, v) in wts.iter().enumerate() {
+                        for ch in 0..3 {
+                            a.coefficients[k][ch] += ra[ch] * v;
+                            b.coefficients[k][ch] += rb[ch] * v;
+                        }
+                    }
+                }
+                (a, b)
+            })
+            .collect();
+        self.sky_response = gathered.iter().map(|g| g.0).collect();
+        self.sun_response = gathered.iter().map(|g| g.1).collect();
+        self.made_for = Some(state);
+        Ok(true)
+    }
+
+    /// Writes `P_a A + P_d B` into every key point of `volume`.
+    pub fn refresh(&self, sky: Rgb, sun: Rgb, volume: &mut IrradianceVolume) -> Result<(), OutdoorError> {
+        let out = volume
+            .layer_mut(VolumeLayer::AllLight)
+            .map_err(|e| OutdoorError::Parameter(e.to_string()))?;
+        if out.len() != self.sky_response.len() {
+            return Err(OutdoorError::Parameter(
+                "the key-point responses were not gathered for this volume".into(),
+            ));
+        }
+        let (pa, pd) = (sky.to_array(), sun.to_array());
+        for ((o, a), b) in out.iter_mut().zip(&self.sky_response).zip(&self.sun_response) {
+            for k in 0..9 {
+                for ch in 0..3 {
+                    o.coefficients[k][ch] = pa[ch] * a.coefficients[k][ch] + pd[ch] * b.coefficients[k][ch];
+                }
+            }
+        }
+        Ok(())
+    }
+}
