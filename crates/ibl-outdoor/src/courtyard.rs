@@ -6,10 +6,12 @@
 //! (`x, z` in [-12, 12]) paved with 1.5 m tiles whose albedo varies by +-20 % around a warm grey
 //! (a hash of the tile index: texture the albedo map must recover); beyond it, a 400 m ground of
 //! darker asphalt. Buildings: a 12 m brick block along the north side (three facades of slightly
-//! different bricks), an 8 m plaster block on the west, a 9 m concrete block on the east, open to
-//! the south; a 3 m kiosk in the yard casts a shadow the camera sees all day. The probe is at the
-//! yard's centre, 1.5 m up; the camera looks down into the yard from 6 m up in the south-west
-//! corner. Every surface is Lambertian (the paper's assumption, section 3.1).
+//! different bricks), an 8 m plaster block on the west, a 6 m concrete block on the east, open to
+//! the south; a 3.5 m kiosk in the yard casts a shadow the camera sees all day. The probe stands
+//! 1.5 m up between the kiosk and the north block (it must see what the camera's samples see,
+//! shade included, and the sun at capture time); the camera looks south-south-east down into the yard from a
+//! window 7 m up in the north block, so it sees the shadows the buildings and the kiosk cast
+//! (northwards) and their shaded north faces as well as sunlit ground. Every surface is Lambertian (the paper's assumption, section 3.1).
 
 use glam::{Vec2, Vec3};
 use ibl_core::{Image, Rgb};
@@ -100,8 +102,8 @@ impl Courtyard {
             ("north facade middle", [-4.0, 0.0, -20.0], [4.0, 12.0, -12.0], diffuse(0.40, 0.23, 0.17)),
             ("north facade east", [4.0, 0.0, -20.0], [12.0, 12.0, -12.0], diffuse(0.50, 0.30, 0.22)),
             ("west block", [-20.0, 0.0, -12.0], [-12.0, 8.0, 8.0], diffuse(0.62, 0.58, 0.50)),
-            ("east block", [12.0, 0.0, -12.0], [18.0, 9.0, 4.0], diffuse(0.38, 0.38, 0.36)),
-            ("kiosk", [2.0, 0.0, -4.0], [4.5, 3.0, -1.5], diffuse(0.55, 0.48, 0.40)),
+            ("east block", [12.0, 0.0, -12.0], [18.0, 6.0, 4.0], diffuse(0.38, 0.38, 0.36)),
+            ("kiosk", [1.5, 0.0, -4.5], [5.0, 3.5, -1.5], diffuse(0.55, 0.48, 0.40)),
         ];
         for (name, lo, hi, material) in boxes {
             meshes.push(placed(
@@ -114,8 +116,8 @@ impl Courtyard {
         let (w, h) = frame_size;
         let focal = Camera::focal_from_vertical_fov(60.0, h);
         let camera = Camera::look_at(
-            Vec3::new(-10.0, 6.0, 11.0),
-            Vec3::new(2.0, 0.5, -5.0),
+            Vec3::new(-3.0, 7.0, -11.5),
+            Vec3::new(2.0, 0.0, 3.0),
             Vec3::Y,
             Vec2::splat(focal),
             Vec2::new(w as f32 / 2.0, h as f32 / 2.0),
@@ -123,7 +125,7 @@ impl Courtyard {
         );
         Courtyard {
             layer,
-            probe_position: Vec3::new(0.0, 1.5, 0.0),
+            probe_position: Vec3::new(0.0, 1.5, -7.0),
             camera,
             volume_box: (Vec3::new(-10.5, 0.3, -10.5), Vec3::new(10.5, 3.3, 10.5)),
         }

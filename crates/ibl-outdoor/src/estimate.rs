@@ -20,7 +20,10 @@
 //! reweighted least squares (Holland & Welsch 1977). The three channels share one weight per
 //! sample, from the root-mean-square of its relative residuals `e_i`, scaled by the robust
 //! spread `sigma = median(e) / 0.888` (the median of `sqrt(chi^2_3 / 3)`: `sigma` is then the
-//! per-channel relative noise for Gaussian residuals). The first iterations use Huber's loss
+//! per-channel relative noise for Gaussian residuals), taken separately for sunlit and shaded
+//! samples: a shaded pixel gets a fraction of the light and so a larger relative noise, and one
+//! scale for both would reject the shade, which is what pins `P_a`. Each sample's least-squares
+//! weight is `1 / (sigma_class y_hat)^2` times its robust weight. The first iterations use Huber's loss
 //! (`k = 1.345`, convex, so the start cannot fall into a bad local minimum), the rest Tukey's
 //! biweight (`c = 4.685`, which gives gross outliers zero weight); both are the 95 %-efficiency
 //! constants of the Gaussian case.
@@ -104,8 +107,9 @@ pub struct Estimate {
     pub inliers: usize,
     /// Inliers in direct sunlight (`k > 0`).
     pub sunlit_inliers: usize,
-    /// Robust relative spread of the residuals (per channel, Gaussian-equivalent).
-    pub residual_spread: f32,
+    /// Robust relative spread of the residuals (per channel, Gaussian-equivalent) of the sunlit
+    /// and of the shaded samples.
+    pub residual_spread: [f32; 2],
     /// IRLS iterations run.
     pub iterations: u32,
 }
@@ -231,7 +235,7 @@ pub fn estimate(
     let mut sun_allowed = sunlit_total >= options.min_sunlit;
     let mut robust = vec![1.0f64; n];
     let mut params = [(0.0f64, 0.0f64); 3];
-    let mut sigma = 0.0f64;
+    let mut sigma = [0.0f64; 2];
     let mut iterations = 0;
     // Relative weights: none in the first, ordinary least-squares fit.
     let mut relative: Vec<[f64; 3]> = vec![[1.0; 3]; n];
@@ -264,10 +268,24 @@ pub fn estimate(
                 (sq / 3.0).sqrt()
             })
             .collect();
-        let mut sorted = rms.clone();
-        sigma = (median(&mut sorted) / RMS3_MEDIAN).max(1e-9);
-        for (w, e) in robust.iter_mut().zip(&rms) {
-            let u = e / sigma;
+        // One robust scale per noise class: sunlit samples (k > 0) and shaded ones, whose
+        // relative noise is larger (less light); a class of fewer than 5 borrows the other's.
+        let class_sigma = |lit: bool| -> Option<f64> {
+            let mut e: Vec<f64> = rows
+                .iter()
+                .zip(&rms)
+                .filter(|(r, _)| (r.v > 0.0) == lit)
+                .map(|(_, e)| *e)
+                .collect();
+            (e.len() >= 5).then(|| (median(&mut e) / RMS3_MEDIAN).max(1e-9))
+        };
+        let (lit_sigma, shade_sigma) = (class_sigma(true), class_sigma(false));
+        sigma = [
+            lit_sigma.or(shade_sigma).unwrap_or(1e-9),
+            shade_sigma.or(lit_sigma).unwrap_or(1e-9),
+        ];
+        for ((w, e), r) in robust.iter_mut().zip(&rms).zip(&rows) {
+            let u = e / sigma[usize::from(r.v <= 0.0)];
             *w = if it < options.huber_iterations {
                 if u <= HUBER_K { 1.0 } else { HUBER_K / u }
             } else if u < TUKEY_C {
@@ -276,8 +294,9 @@ pub fn estimate(
                 0.0
             };
         }
-        for (h, p) in relative.iter_mut().zip(&predictions) {
-            *h = [0, 1, 2].map(|c| 1.0 / p[c].max(floors[c]).powi(2));
+        for ((h, p), r) in relative.iter_mut().zip(&predictions).zip(&rows) {
+            let class = sigma[usize::from(r.v <= 0.0)];
+            *h = [0, 1, 2].map(|c| 1.0 / (class * p[c].max(floors[c])).powi(2));
         }
         let change = (0..3)
             .map(|c| {
@@ -362,7 +381,7 @@ pub fn estimate(
         samples: n,
         inliers,
         sunlit_inliers,
-        residual_spread: sigma as f32,
+        residual_spread: [sigma[0] as f32, sigma[1] as f32],
         iterations,
     })
 }
@@ -443,7 +462,9 @@ mod tests {
             // 5 % noise over ~250 samples per column: about 0.5 % standard error.
             assert!(e.sun_std[c] < 0.01 * sun.to_array()[c]);
         }
-        assert!((e.residual_spread - 0.05).abs() < 0.01, "{}", e.residual_spread);
+        for spread in e.residual_spread {
+            assert!((spread - 0.05).abs() < 0.01, "{spread}");
+        }
         // 20 % gross outliers: the same answer within 2 %, most outliers at zero weight.
         let dirty = synthetic(sun, sky, 500, 0.05, 0.2, 0.5, 3);
         let robust = estimate(&dirty, &EstimatorOptions::default()).unwrap();

@@ -75,7 +75,7 @@ impl Default for MapSettings {
     fn default() -> Self {
         MapSettings {
             sky_model: SkyModel::Preetham { turbidity: 3.0 },
-            transfer_bands: 4,
+            transfer_bands: 8,
             transfer_rays: 256,
             seed: 1,
         }
@@ -333,6 +333,14 @@ fn measure_capture(
         ));
     }
     let pa = [0, 1, 2].map(|c| num[c] / den[c]);
+    let (si, sj) = projection.pixel_towards(sun);
+    if !sky(si, sj) {
+        return Err(OutdoorError::Parameter(
+            "the model hides the sun from the probe at capture time, so the probe cannot measure \
+             it: give the capture lighting instead"
+                .into(),
+        ));
+    }
     let cap = SUN_CAP_RADIUS.max(3.0 * PI / h as f64);
     let mut e_sun = [0.0f64; 3];
     for j in 0..h {

@@ -4,11 +4,12 @@
 //!
 //! A camera pixel is a **candidate** when it is marked in the mask, its centre ray meets the
 //! model, the probe saw that point ([`crate::view::ProbeProjection::pixel_of`]) and the probe's
-//! albedo there is known and in `[min_albedo, 1]`, and the site is **stable**: the camera pixel's
-//! eight neighbours see surfaces of the same normal (no geometric edge), and the probe pixel's
-//! eight neighbours are surfaces with the same capture shadow and albedos within
-//! `albedo_tolerance` (relative) of it (no texture or shadow edge the two views would sample
-//! differently). Sites are drawn uniformly without replacement among candidates (seeded), once:
+//! albedo there is known, and the site is **stable**: the camera pixel's eight neighbours see
+//! surfaces of the same normal (no geometric edge), and the probe pixel's 3 x 3 neighbourhood is
+//! all surface with one capture shadow and albedos within `albedo_tolerance` (relative, default
+//! 30 %: the probe's own noise stays inside it, most texture and shadow edges the two views would
+//! sample differently do not). The site's albedo is the mean of those nine, in `[min_albedo, 1]`
+//! (a third of the probe's per-pixel noise). Sites are drawn uniformly without replacement among candidates (seeded), once:
 //! the same pixels are read every frame, so frame-to-frame changes are changes of light. Each
 //! site gets its own sky transfer vector with many rays (default 1024: a standard error of `c`
 //! of at most 1.6 %), its shadow is cast whenever the sun moves past the threshold, and its
@@ -37,7 +38,7 @@ pub struct SampleSettings {
     pub transfer_rays: u32,
     /// Smallest albedo in any channel.
     pub min_albedo: f32,
-    /// Largest relative albedo difference to the probe pixel's neighbours.
+    /// Largest relative difference of the probe's 3 x 3 albedos from their mean.
     pub albedo_tolerance: f32,
     /// Seed of the draw and of the rays.
     pub seed: u64,
@@ -49,7 +50,7 @@ impl Default for SampleSettings {
             count: 500,
             transfer_rays: 1024,
             min_albedo: 0.02,
-            albedo_tolerance: 0.1,
+            albedo_tolerance: 0.3,
             seed: 7,
         }
     }
@@ -116,22 +117,31 @@ impl SampleSites {
                 if pj == 0 || pj + 1 >= ph {
                     continue;
                 }
-                let Some((d, s0)) = probe_albedo(pi, pj) else { continue };
+                let Some((_, s0)) = probe_albedo(pi, pj) else { continue };
+                // The probe's 3 x 3 neighbourhood: all surface, one capture shadow, albedos
+                // within the tolerance of their mean (which is the site's albedo: a third of
+                // the probe's per-pixel noise).
+                let mut block = Vec::with_capacity(9);
+                for b in pj - 1..=pj + 1 {
+                    for a in [(pi + pw - 1) % pw, pi, (pi + 1) % pw] {
+                        match probe_albedo(a, b) {
+                            Some((o, os)) if os == s0 => block.push(o),
+                            _ => break,
+                        }
+                    }
+                }
+                if block.len() != 9 {
+                    continue;
+                }
+                let d = block.iter().fold(Rgb::ZERO, |acc, &o| acc + o) / 9.0;
                 if d.to_array()
                     .iter()
                     .any(|&v| !(v >= settings.min_albedo && v <= 1.0))
                 {
                     continue;
                 }
-                let stable = (pj - 1..=pj + 1).all(|b| {
-                    [(pi + pw - 1) % pw, pi, (pi + 1) % pw].iter().all(|&a| {
-                        probe_albedo(a, b).is_some_and(|(o, os)| {
-                            os == s0
-                                && (0..3).all(|c| {
-                                    (o[c] - d[c]).abs() <= settings.albedo_tolerance * d[c]
-                                })
-                        })
-                    })
+                let stable = block.iter().all(|o| {
+                    (0..3).all(|c| (o[c] - d[c]).abs() <= settings.albedo_tolerance * d[c])
                 });
                 if stable {
                     candidates.push((

@@ -137,7 +137,7 @@ mod tests {
             samples: 500,
             inliers: 500,
             sunlit_inliers: 250,
-            residual_spread: 0.05,
+            residual_spread: [0.05; 2],
             iterations: 10,
         }
     }

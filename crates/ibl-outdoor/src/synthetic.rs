@@ -106,7 +106,7 @@ pub struct SyntheticDay {
 
 impl SyntheticDay {
     /// The documented day: Aalborg (57.05 N, 9.92 E, the paper's city) on 20 April 2024 at UTC+2,
-    /// frames every 30 minutes from 09:00 to 17:00 (17 frames); a cloud at 11:00 (sun x 0.3) and
+    /// frames every 30 minutes from 09:30 to 17:00 (16 frames); a cloud at 11:00 (sun x 0.3) and
     /// 11:30 (x 0.6), overcast from 14:00 to 15:00 (3 frames); turbidity 3; small renders for CI
     /// (probe 256 x 128 at 32 spp, frames 160 x 120 at 16 spp, direct light only).
     pub fn standard() -> SyntheticDay {
@@ -115,11 +115,11 @@ impl SyntheticDay {
             elevation_m: 5.0,
             ..Location::new(57.05, 9.92)
         };
-        let start = Timestamp::from_local(2024, 4, 20, 9, 0, 0.0, 2.0).expect("a valid date");
-        let mut weather = vec![Weather::Clear; 17];
-        weather[4] = Weather::Cloud { sun_factor: 0.3 };
-        weather[5] = Weather::Cloud { sun_factor: 0.6 };
-        for w in &mut weather[10..13] {
+        let start = Timestamp::from_local(2024, 4, 20, 9, 30, 0.0, 2.0).expect("a valid date");
+        let mut weather = vec![Weather::Clear; 16];
+        weather[3] = Weather::Cloud { sun_factor: 0.3 };
+        weather[4] = Weather::Cloud { sun_factor: 0.6 };
+        for w in &mut weather[9..12] {
             *w = Weather::Overcast;
         }
         SyntheticDay {
@@ -131,8 +131,8 @@ impl SyntheticDay {
             probe_width: 256,
             frame_size: (160, 120),
             environment_width: 1024,
-            probe_spp: 32,
-            frame_spp: 16,
+            probe_spp: 64,
+            frame_spp: 48,
             bounces: 1,
             seed: 1,
         }
@@ -259,7 +259,7 @@ impl SyntheticDay {
             &self.settings(self.probe_width, self.probe_spp, seed),
             &|_, _| {},
         )?;
-        Ok(out.composite)
+        Ok(out.with_objects)
     }
 
     /// The path-traced frame of the yard's camera under `truth`.
@@ -277,7 +277,7 @@ impl SyntheticDay {
             &self.settings(self.frame_size.0, self.frame_spp, seed),
             &|_, _| {},
         )?;
-        Ok(out.composite)
+        Ok(out.with_objects)
     }
 }
 
@@ -365,8 +365,8 @@ mod tests {
             assert!((sun_e[c] / want_sun - 1.0).abs() < 1e-3, "{sun_e:?} {want_sun}");
         }
         // Overcast has no sun; clouds dim it.
-        assert_eq!(day.frame_truth(11).unwrap().parameters.sun, [0.0; 3]);
-        let cloud = day.frame_truth(4).unwrap();
+        assert_eq!(day.frame_truth(10).unwrap().parameters.sun, [0.0; 3]);
+        let cloud = day.frame_truth(3).unwrap();
         assert!((cloud.parameters.sun[0] / cloud.clear_sun[0] - 0.3).abs() < 1e-6);
     }
 }
