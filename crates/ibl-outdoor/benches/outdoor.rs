@@ -130,7 +130,7 @@ fn bench(c: &mut Criterion) {
             estimate(&obs, &options).expect("estimate")
         })
     });
-    let mut relighter = Relighter::new(0.0044);
+    let mut relighter = Relighter::new(sys.maps(), 0.0044);
     relighter
         .update(sys.layer(), sys.maps(), &sky, sun)
         .expect("relighter");

@@ -55,6 +55,7 @@ pub use system::{
     CameraSetup, FrameResult, OutdoorSystem, ProbeCapture, SystemSettings, VolumeRefresh,
     VolumeSettings,
 };
+pub use tracking::SkyCondition;
 pub use volume_refresh::{KeyPointRelighter, MapGather};
 
 /// Why an outdoor operation could not run.

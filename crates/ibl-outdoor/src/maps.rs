@@ -21,9 +21,16 @@
 //! radiance scaled with the sky ([`crate::relight`]). Albedos above 1 are kept (they flag light
 //! the model does not have, such as interreflections) but samples use only albedos in `(0, 1]`.
 //!
+//! The sun term `s_0 max(0, n . l_0)` is the mean over the pixel's footprint, a grid of
+//! `footprint_side^2` sub-pixel rays ([`crate::tracking::PointLighting`]): a probe pixel across a
+//! shadow edge, or a grazing ground pixel that spans metres, is partly sunlit, and a binary
+//! value at its centre would give it a wrong albedo (measured on the synthetic day: the relit
+//! map's error against the path-traced probe, with the true lighting, fell from 5.0 % to 3.2 %).
+//!
 //! **Normal map**: the unit normal of each surface pixel, facing the probe, as RGB = XYZ (the
 //! paper renders it in two passes with coloured principal lights; ray casting gives it directly).
-//! **Shadow map**: [`crate::shadow`] at the surface pixels. **Weighted ambient**: [`crate::transfer`].
+//! **Shadow map**: [`crate::shadow`] at the surface pixels (at their centres, binary, as the
+//! paper's). **Weighted ambient**: [`crate::transfer`].
 
 use std::f64::consts::PI;
 
@@ -36,7 +43,9 @@ use crate::OutdoorError;
 use crate::shadow::sun_visibility;
 use crate::sky::{SkyModel, SkyShape};
 use crate::transfer::{AmbientTransfer, SurfacePoint};
-use crate::view::ProbeProjection;
+use crate::tracking::{PointLighting, SkyTracker};
+use crate::view::{ProbeProjection, pixel_footprint};
+use rayon::prelude::*;
 
 /// The sun and sky parameters at one instant, with the sun's direction.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -67,6 +76,9 @@ pub struct MapSettings {
     pub transfer_bands: usize,
     /// Cosine rays per surface pixel for the transfer vectors.
     pub transfer_rays: u32,
+    /// Sub-pixel rays per side of each pixel's footprint for the sun term (2: four shadow rays
+    /// per pixel; 1: the paper's one binary value at the pixel centre).
+    pub footprint_side: usize,
     /// Seed of the ray jitter.
     pub seed: u64,
 }
@@ -77,6 +89,7 @@ impl Default for MapSettings {
             sky_model: SkyModel::Preetham { turbidity: 3.0 },
             transfer_bands: 8,
             transfer_rays: 256,
+            footprint_side: 2,
             seed: 1,
         }
     }
@@ -94,8 +107,10 @@ pub struct ProbeMaps {
     points: Vec<SurfacePoint>,
     transfer: AmbientTransfer,
     albedo: Vec<Option<Rgb>>,
+    footprints: Vec<SurfacePoint>,
+    footprint_size: usize,
     capture: LightingParameters,
-    capture_shadow: Vec<f32>,
+    capture_sun_terms: Vec<f32>,
     probe: Image<Rgb>,
 }
 
@@ -160,15 +175,35 @@ impl ProbeMaps {
                 measure_capture(probe, &projection, &point_of_pixel, capture_sun, &shape)?
             }
         };
-        let capture_shadow = sun_visibility(layer, &points, capture_sun);
+        let side = settings.footprint_side.clamp(1, 8);
+        let camera = ibl_scene::Camera::Panorama {
+            position,
+            world_from_probe,
+        };
+        let footprints: Vec<SurfacePoint> = pixels
+            .par_iter()
+            .flat_map_iter(|&p| {
+                let centre = projection.view.hits()[p].expect("surface pixel");
+                pixel_footprint(layer, &camera, w, h, p % w, p / w, side, centre)
+                    .into_iter()
+                    .map(|hit| SurfacePoint {
+                        position: hit.position,
+                        normal: hit.normal,
+                    })
+            })
+            .collect();
+        let mut capture_lighting = PointLighting::new(0.0, footprints.clone(), side * side);
+        let mut capture_sky = SkyTracker::new(settings.sky_model, settings.transfer_bands, 0.0);
+        capture_sky.update(capture_sun)?;
+        capture_lighting.update(layer, &points, &transfer, &capture_sky, capture_sun)?;
+        let capture_sun_terms: Vec<f32> = (0..points.len())
+            .map(|k| capture_lighting.sun_term(k, capture_sun))
+            .collect();
         let (pa, pd) = (Rgb::from_array(capture.sky), Rgb::from_array(capture.sun));
-        let l0 = Vec3::from_array(capture.sun_direction);
-        let albedo = points
-            .iter()
-            .enumerate()
-            .map(|(k, p)| {
-                let c = transfer.sky_ambient(k, &shape);
-                let sun_term = capture_shadow[k] * p.normal.dot(l0).max(0.0);
+        let albedo = (0..points.len())
+            .map(|k| {
+                let c = capture_lighting.sky_terms()[k];
+                let sun_term = capture_sun_terms[k];
                 let denominator = c * pa + pd * sun_term;
                 let observed = probe.pixels()[pixels[k]];
                 let ok = (0..3).all(|ch| denominator[ch] > MIN_DENOMINATOR * pa[ch]);
@@ -189,8 +224,10 @@ impl ProbeMaps {
             points,
             transfer,
             albedo,
+            footprints,
+            footprint_size: side * side,
             capture,
-            capture_shadow,
+            capture_sun_terms,
             probe: probe.clone(),
         })
     }
@@ -241,9 +278,20 @@ impl ProbeMaps {
         self.capture
     }
 
-    /// `s` of each surface point at capture time.
-    pub fn capture_shadow(&self) -> &[f32] {
-        &self.capture_shadow
+    /// The sun term `k` of each surface point at capture time (its footprint's mean of `s max(0,
+    /// n . l_0)`).
+    pub fn capture_sun_terms(&self) -> &[f32] {
+        &self.capture_sun_terms
+    }
+
+    /// Each surface pixel's footprint points, [`Self::footprint_size`] per point in point order.
+    pub fn footprints(&self) -> &[SurfacePoint] {
+        &self.footprints
+    }
+
+    /// Footprint points per surface pixel.
+    pub fn footprint_size(&self) -> usize {
+        self.footprint_size
     }
 
     /// The probe image.

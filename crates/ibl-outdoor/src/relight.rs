@@ -54,11 +54,15 @@ pub struct Relighter {
 }
 
 impl Relighter {
-    /// A relighter whose shadow map is re-cast when the sun moves more than
+    /// A relighter for `maps` whose shadow map is re-cast when the sun moves more than
     /// `shadow_threshold_rad`.
-    pub fn new(shadow_threshold_rad: f32) -> Relighter {
+    pub fn new(maps: &ProbeMaps, shadow_threshold_rad: f32) -> Relighter {
         Relighter {
-            lighting: PointLighting::new(shadow_threshold_rad),
+            lighting: PointLighting::new(
+                shadow_threshold_rad,
+                maps.footprints().to_vec(),
+                maps.footprint_size(),
+            ),
             sky_pixels: Vec::new(),
             sky_generation: 0,
         }
@@ -127,7 +131,6 @@ impl Relighter {
             sky.g / capture_sky.g.max(1e-30),
             sky.b / capture_sky.b.max(1e-30),
         );
-        let points = maps.points();
         let albedo = maps.albedo();
         let terms = self.lighting.sky_terms();
         let probe = maps.probe().pixels();
@@ -142,7 +145,7 @@ impl Relighter {
                         None => self.sky_pixels[p] * sky,
                         Some(k) => match albedo[k] {
                             Some(d) => {
-                                let k_sun = self.lighting.sun_term(k, points[k].normal, sun_direction);
+                                let k_sun = self.lighting.sun_term(k, sun_direction);
                                 d * (terms[k] * sky + sun * k_sun)
                             }
                             None => probe[p] * sky_ratio,

@@ -27,7 +27,7 @@ use crate::estimate::Observation;
 use crate::maps::ProbeMaps;
 use crate::tracking::{PointLighting, SkyTracker};
 use crate::transfer::{AmbientTransfer, SurfacePoint};
-use crate::view::ViewGeometry;
+use crate::view::{ViewGeometry, pixel_footprint};
 
 /// How sample sites are chosen.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -92,7 +92,7 @@ impl SampleSites {
         let projection = maps.projection();
         let (pw, ph) = maps.size();
         let albedo = maps.albedo();
-        let shadow0 = maps.capture_shadow();
+        let shadow0 = maps.capture_sun_terms();
         let probe_albedo = |i: usize, j: usize| -> Option<(Rgb, f32)> {
             let k = maps.point_of_pixel(j * pw + i)?;
             albedo[k].map(|a| (a, shadow0[k]))
@@ -168,6 +168,19 @@ impl SampleSites {
         chosen.sort_unstable();
         let picked: Vec<_> = chosen.iter().map(|&k| candidates[k]).collect();
         let points: Vec<SurfacePoint> = picked.iter().map(|c| c.2).collect();
+        let side = maps.settings().footprint_side.clamp(1, 8);
+        let footprints: Vec<SurfacePoint> = picked
+            .iter()
+            .flat_map(|c| {
+                let centre = view.hit(c.0, c.1).copied().expect("a site sees a surface");
+                pixel_footprint(layer, camera, w, h, c.0, c.1, side, centre)
+                    .into_iter()
+                    .map(|hit| SurfacePoint {
+                        position: hit.position,
+                        normal: hit.normal,
+                    })
+            })
+            .collect();
         let transfer = AmbientTransfer::compute(
             layer,
             &points,
@@ -181,7 +194,7 @@ impl SampleSites {
             albedo: picked.iter().map(|c| c.3).collect(),
             points,
             transfer,
-            lighting: PointLighting::new(shadow_threshold_rad),
+            lighting: PointLighting::new(shadow_threshold_rad, footprints, side * side),
             candidates: candidates.len(),
         })
     }
@@ -241,7 +254,7 @@ impl SampleSites {
                 observed: *frame.get(i, j),
                 albedo: self.albedo[k],
                 sky_term: self.lighting.sky_terms()[k],
-                sun_term: self.lighting.sun_term(k, self.points[k].normal, sun),
+                sun_term: self.lighting.sun_term(k, sun),
             })
             .collect())
     }

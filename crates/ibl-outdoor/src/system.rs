@@ -5,7 +5,8 @@
 //! [`OutdoorSystem::new`] and [`OutdoorSystem::process`].
 //!
 //! Order per frame: sun direction (SPA) -> sky shape and shadows if the sun moved past their
-//! thresholds -> observations at the sample sites -> robust estimate -> optional temporal
+//! thresholds -> observations at the sample sites -> robust estimate (again with the overcast
+//! sky when the sun turns out too weak, or with the clear one when it is back) -> optional temporal
 //! smoothing -> relit map (the smoothed estimate) -> volume refresh, (a) from the relit map or (b)
 //! from the key-point responses.
 
@@ -23,7 +24,7 @@ use crate::samples::{SampleSettings, SampleSites};
 use crate::shadow::DEFAULT_SHADOW_THRESHOLD_RAD;
 use crate::smoothing::{SmoothingOptions, TemporalFilter};
 use crate::sun::{DeltaT, Location, Timestamp};
-use crate::tracking::{DEFAULT_SKY_THRESHOLD_RAD, SkyTracker};
+use crate::tracking::{DEFAULT_SKY_THRESHOLD_RAD, SkyCondition, SkyTracker};
 use crate::volume_refresh::{KeyPointRelighter, MapGather};
 
 /// How the volume is refreshed each frame.
@@ -65,6 +66,11 @@ pub struct SystemSettings {
     pub volume: Option<VolumeSettings>,
     /// `TT - UT` for the sun.
     pub delta_t: DeltaT,
+    /// A frame whose estimated sun luminance `Y(P_d)` is below this fraction of the sky's `Y(P_a)`
+    /// (or whose sun is not observable) is overcast: it is estimated again, relit and its volume
+    /// refreshed with the CIE overcast sky instead of the clear one (`None`: always clear, as
+    /// the paper). Clear days give `P_d / P_a` of 5 to 20, a cloud in front of the sun 2 to 5.
+    pub overcast_below: Option<f32>,
 }
 
 impl Default for SystemSettings {
@@ -78,6 +84,7 @@ impl Default for SystemSettings {
             sky_threshold_rad: DEFAULT_SKY_THRESHOLD_RAD,
             volume: None,
             delta_t: DeltaT::Estimated,
+            overcast_below: Some(1.0),
         }
     }
 }
@@ -121,6 +128,8 @@ pub struct FrameResult {
     pub estimate: Estimate,
     /// The sun as a directional light (from `estimate`).
     pub sun: SunLight,
+    /// The sky the frame was estimated and relit with.
+    pub sky_condition: SkyCondition,
 }
 
 /// The offline state and the per-frame loop.
@@ -181,7 +190,7 @@ impl OutdoorSystem {
                 settings.maps.transfer_bands,
                 settings.sky_threshold_rad,
             ),
-            relighter: Relighter::new(settings.shadow_threshold_rad),
+            relighter: Relighter::new(&maps, settings.shadow_threshold_rad),
             filter: settings.smoothing.map(TemporalFilter::new),
             settings,
             layer,
@@ -207,9 +216,19 @@ impl OutdoorSystem {
         let first = *self.first_time.get_or_insert(time);
         let time_s = time.seconds_since(first);
         self.sky.update(sun)?;
-        self.sites.update(&self.layer, &self.sky, sun)?;
-        let observations = self.sites.observations(frame, sun)?;
-        let raw = estimate(&observations, &self.settings.estimator)?;
+        let mut raw = self.estimate_frame(frame, sun)?;
+        if let Some(ratio) = self.settings.overcast_below {
+            let overcast = !raw.sun_observable
+                || raw.sun_rgb().luminance() < ratio * raw.sky_rgb().luminance();
+            let condition = if overcast {
+                SkyCondition::Overcast
+            } else {
+                SkyCondition::Clear
+            };
+            if self.sky.set_condition(condition, sun)? {
+                raw = self.estimate_frame(frame, sun)?;
+            }
+        }
         let estimate = match &mut self.filter {
             Some(f) => f.update(time_s, &raw),
             None => raw,
@@ -236,7 +255,14 @@ impl OutdoorSystem {
             raw,
             estimate,
             sun: SunLight::new(sun, pd),
+            sky_condition: self.sky.condition(),
         })
+    }
+
+    fn estimate_frame(&mut self, frame: &Image<Rgb>, sun: Vec3) -> Result<Estimate, OutdoorError> {
+        self.sites.update(&self.layer, &self.sky, sun)?;
+        let observations = self.sites.observations(frame, sun)?;
+        estimate(&observations, &self.settings.estimator)
     }
 
     /// The relit map of the last frame (probe frame, lat-long).

@@ -1,5 +1,5 @@
 //! What changes with the sun, and when to recompute it: the sky shape (re-made when the sun has
-//! moved more than a threshold, default 1 degree) and, per set of surface points, the shadow map
+//! moved more than a threshold, default 1 degree, or when the sky turns overcast or clears) and, per set of surface points, the shadow map
 //! (default 0.25 degrees, [`crate::shadow`]) and the sky terms `c_shape` that depend on the shape.
 //!
 //! The per-pixel model (Jensen, Andersen & Madsen 2006, section 4.2) needs for every point its
@@ -20,10 +20,20 @@ use crate::transfer::{AmbientTransfer, SurfacePoint};
 /// Default sky-shape threshold, radians (1 degree).
 pub const DEFAULT_SKY_THRESHOLD_RAD: f32 = std::f32::consts::PI / 180.0;
 
+/// Whether the sky is clear or overcast (which shape a frame uses).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+pub enum SkyCondition {
+    /// The clear-sky model of the settings (Preetham, or uniform).
+    Clear,
+    /// The CIE overcast sky (no sun).
+    Overcast,
+}
+
 /// The current sky shape.
 #[derive(Clone, Debug)]
 pub struct SkyTracker {
     model: SkyModel,
+    condition: SkyCondition,
     bands: usize,
     threshold_rad: f32,
     shape: Option<SkyShape>,
@@ -35,6 +45,7 @@ impl SkyTracker {
     pub fn new(model: SkyModel, bands: usize, threshold_rad: f32) -> SkyTracker {
         SkyTracker {
             model,
+            condition: SkyCondition::Clear,
             bands,
             threshold_rad: threshold_rad.max(0.0),
             shape: None,
@@ -42,16 +53,38 @@ impl SkyTracker {
         }
     }
 
-    /// Makes the shape current for `sun`; returns whether it was re-made.
+    /// Makes the shape current for `sun` under the current condition; returns whether it was
+    /// re-made.
     pub fn update(&mut self, sun: Vec3) -> Result<bool, OutdoorError> {
         if let Some(shape) = &self.shape
             && shape.sun().dot(sun).clamp(-1.0, 1.0).acos() <= self.threshold_rad
         {
             return Ok(false);
         }
-        self.shape = Some(SkyShape::new(self.model, sun, self.bands)?);
+        let model = match self.condition {
+            SkyCondition::Clear => self.model,
+            SkyCondition::Overcast => SkyModel::CieOvercast,
+        };
+        self.shape = Some(SkyShape::new(model, sun, self.bands)?);
         self.generation += 1;
         Ok(true)
+    }
+
+    /// Switches between the clear and the overcast shape (re-made at once for `sun` when the
+    /// condition changes); returns whether it changed.
+    pub fn set_condition(&mut self, condition: SkyCondition, sun: Vec3) -> Result<bool, OutdoorError> {
+        if condition == self.condition && self.shape.is_some() {
+            return Ok(false);
+        }
+        self.condition = condition;
+        self.shape = None;
+        self.update(sun)?;
+        Ok(true)
+    }
+
+    /// The current condition.
+    pub fn condition(&self) -> SkyCondition {
+        self.condition
     }
 
     /// The current shape; an error before the first [`Self::update`].
@@ -72,18 +105,31 @@ impl SkyTracker {
     }
 }
 
-/// The sun-dependent terms of a set of surface points.
+/// The sun-dependent terms of a set of surface points, each seen through a pixel whose
+/// footprint is `per_point` sub-pixel surface points: the sun term is their mean,
+/// `k = (1 / S) sum_j s_j max(0, n_j . l)`, so a pixel across a shadow edge or a geometric edge
+/// gets the fraction of sunlight its footprint receives (the sky term uses the centre's
+/// transfer vector).
 #[derive(Clone, Debug)]
 pub struct PointLighting {
+    footprints: Vec<SurfacePoint>,
+    per_point: usize,
     shadow: ShadowState,
     sky_terms: Vec<Rgb>,
     sky_generation: u64,
 }
 
 impl PointLighting {
-    /// Empty; shadows re-cast when the sun moves more than `shadow_threshold_rad`.
-    pub fn new(shadow_threshold_rad: f32) -> PointLighting {
+    /// Empty; `footprints` holds `per_point` sub-points per point, in point order; shadows are
+    /// re-cast when the sun moves more than `shadow_threshold_rad`.
+    pub fn new(
+        shadow_threshold_rad: f32,
+        footprints: Vec<SurfacePoint>,
+        per_point: usize,
+    ) -> PointLighting {
         PointLighting {
+            footprints,
+            per_point: per_point.max(1),
             shadow: ShadowState::new(shadow_threshold_rad),
             sky_terms: Vec::new(),
             sky_generation: 0,
@@ -100,7 +146,15 @@ impl PointLighting {
         sky: &SkyTracker,
         sun: Vec3,
     ) -> Result<(), OutdoorError> {
-        self.shadow.update(layer, points, sun);
+        if self.footprints.len() != points.len() * self.per_point {
+            return Err(OutdoorError::Parameter(format!(
+                "{} footprint points for {} points of {} each",
+                self.footprints.len(),
+                points.len(),
+                self.per_point
+            )));
+        }
+        self.shadow.update(layer, &self.footprints, sun);
         if self.sky_generation != sky.generation() || self.sky_terms.len() != points.len() {
             self.sky_terms = transfer.sky_ambient_all(sky.shape()?);
             self.sky_generation = sky.generation();
@@ -118,8 +172,15 @@ impl PointLighting {
         &self.shadow
     }
 
-    /// `k = s max(0, n . l)` of point `i` with normal `normal` for the sun towards `sun`.
-    pub fn sun_term(&self, i: usize, normal: Vec3, sun: Vec3) -> f32 {
-        self.shadow.visibility()[i] * normal.dot(sun).max(0.0)
+    /// `k` of point `i` for the sun towards `sun`: the footprint's mean of `s max(0, n . l)`.
+    pub fn sun_term(&self, i: usize, sun: Vec3) -> f32 {
+        let s = self.per_point;
+        let vis = &self.shadow.visibility()[i * s..(i + 1) * s];
+        let sum: f32 = self.footprints[i * s..(i + 1) * s]
+            .iter()
+            .zip(vis)
+            .map(|(p, v)| v * p.normal.dot(sun).max(0.0))
+            .sum();
+        sum / s as f32
     }
 }

@@ -91,6 +91,36 @@ impl ViewGeometry {
     }
 }
 
+/// The surface points of a `side x side` grid of sub-pixel rays through pixel `(i, j)` (at
+/// `(i + (a + 0.5) / side, j + (b + 0.5) / side)`) of a `width x height` image of `camera`; a
+/// sub-ray that meets nothing takes `centre`. Used to integrate the sun term over a pixel's
+/// footprint (shadow edges, grazing ground).
+#[allow(clippy::too_many_arguments)]
+pub fn pixel_footprint(
+    layer: &GeometryLayer,
+    camera: &Camera,
+    width: usize,
+    height: usize,
+    i: usize,
+    j: usize,
+    side: usize,
+    centre: SurfaceHit,
+) -> Vec<SurfaceHit> {
+    let mut out = Vec::with_capacity(side * side);
+    for b in 0..side {
+        for a in 0..side {
+            let ray = camera.ray(
+                i as f32 + (a as f32 + 0.5) / side as f32,
+                j as f32 + (b as f32 + 0.5) / side as f32,
+                width as u32,
+                height as u32,
+            );
+            out.push(cast(layer, &ray).unwrap_or(centre));
+        }
+    }
+    out
+}
+
 /// The closest hit of `ray` in `layer`, with the normal turned towards the ray's origin.
 pub fn cast(layer: &GeometryLayer, ray: &Ray) -> Option<SurfaceHit> {
     let hit = layer.bvh.closest_hit(ray, 0.0, f32::INFINITY)?;

@@ -273,11 +273,10 @@ impl KeyPointRelighter {
         let capture_sky = Rgb::from_array(maps.capture().sky);
         let lighting = relighter.lighting();
         let terms = lighting.sky_terms();
-        let points = maps.points();
         let albedo = maps.albedo();
         let probe = maps.probe().pixels();
         let sky_pixels = relighter.sky_pixels();
-        if sky_pixels.len() != w * h || terms.len() != points.len() {
+        if sky_pixels.len() != w * h || terms.len() != maps.points().len() {
             return Err(OutdoorError::Parameter(
                 "the relighter was not updated for these maps".into(),
             ));
@@ -289,7 +288,7 @@ impl KeyPointRelighter {
                 Some(k) => match albedo[k] {
                     Some(d) => (
                         d * terms[k],
-                        d * lighting.sun_term(k, points[k].normal, sun),
+                        d * lighting.sun_term(k, sun),
                     ),
                     None => (
                         Rgb::new(
