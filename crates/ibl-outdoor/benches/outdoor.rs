@@ -11,6 +11,8 @@
 //!
 //! Run: `cargo bench -p ibl-outdoor --bench outdoor`.
 
+#![allow(missing_docs)] // `criterion_group!` generates an undocumented function
+
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::Mat3;
 use ibl_core::{Image, Rgb};
@@ -20,8 +22,8 @@ use ibl_outdoor::synthetic::SyntheticDay;
 use ibl_outdoor::tracking::SkyTracker;
 use ibl_outdoor::{
     CameraSetup, CaptureSource, KeyPointRelighter, MapGather, MapSettings, OutdoorSystem,
-    ProbeCapture, Relighter, SampleSettings, SampleSites, SkyModel, SystemSettings,
-    VolumeRefresh, VolumeSettings,
+    ProbeCapture, Relighter, SampleSettings, SampleSites, SkyModel, SystemSettings, VolumeRefresh,
+    VolumeSettings,
 };
 use ibl_sh::VolumeGrid;
 
@@ -45,8 +47,12 @@ fn setup() -> Setup {
     let frame = day
         .render_frame(&yard, &day.frame_truth(6).expect("truth"), 2)
         .expect("frame");
-    let grid = VolumeGrid::covering(yard.volume_box.0.as_dvec3(), yard.volume_box.1.as_dvec3(), 3.0)
-        .expect("grid");
+    let grid = VolumeGrid::covering(
+        yard.volume_box.0.as_dvec3(),
+        yard.volume_box.1.as_dvec3(),
+        3.0,
+    )
+    .expect("grid");
     Setup {
         day,
         yard,
@@ -115,10 +121,7 @@ fn bench(c: &mut Criterion) {
     }
     // The parts on their own, caches warm.
     let sys = system(&s, VolumeRefresh::FromMap);
-    let sun = s
-        .day
-        .sun_direction(s.day.frame_time(6))
-        .expect("sun");
+    let sun = s.day.sun_direction(s.day.frame_time(6)).expect("sun");
     let mut sky = SkyTracker::new(SkyModel::Preetham { turbidity: 3.0 }, 4, 0.0175);
     sky.update(sun).expect("sky");
     let mut sites: SampleSites = sys.sites().clone();
@@ -146,7 +149,11 @@ fn bench(c: &mut Criterion) {
     let mut gather = MapGather::new(sys.layer(), sys.maps(), s.grid, 32).expect("gather");
     let mut volume = gather.empty_volume();
     group.bench_function("volume_from_map", |b| {
-        b.iter(|| gather.refresh(&relit, &sky, pa, &mut volume).expect("refresh"))
+        b.iter(|| {
+            gather
+                .refresh(&relit, &sky, pa, &mut volume)
+                .expect("refresh")
+        })
     });
     let mut keys = KeyPointRelighter::new();
     keys.update(&mut gather, sys.maps(), &relighter, &sky, sun)

@@ -18,10 +18,10 @@ use ibl_io::tonemap::auto_exposure_stops;
 use ibl_io::{Display, ToneCurve, WriteOptions, write_atomically, write_image};
 use ibl_outdoor::courtyard::Courtyard;
 use ibl_outdoor::plot::{SeriesPoint, estimates_svg};
-use ibl_outdoor::synthetic::{SyntheticDay, Weather};
+use ibl_outdoor::synthetic::{SyntheticDay, Weather, map_error};
 use ibl_outdoor::{
-    CameraSetup, CaptureSource, MapSettings, OutdoorSystem, ProbeCapture, SampleSettings,
-    SkyModel, SystemSettings, VolumeRefresh, VolumeSettings,
+    CameraSetup, CaptureSource, MapSettings, OutdoorSystem, ProbeCapture, SampleSettings, SkyModel,
+    SystemSettings, VolumeRefresh, VolumeSettings,
 };
 use ibl_sh::VolumeGrid;
 
@@ -37,40 +37,13 @@ fn png(dir: &Path, name: &str, image: &Image<Rgb>, exposure: Option<f32>) {
     write_image(&dir.join(name), image, &options).expect("write a PNG");
 }
 
-/// Mean absolute error over 4 x 4 texel blocks, solid-angle weighted, per cent of the truth's
-/// mean, averaged over channels, texels within 3 degrees of the sun left out (as the test).
-fn map_error(got: &Image<Rgb>, want: &Image<Rgb>, sun: Vec3) -> f64 {
-    let (w, h) = (want.width(), want.height());
-    let grid = ibl_core::LatLong::new(w, h);
-    let omega = grid.row_solid_angles();
-    let (mut err, mut sum) = ([0.0f64; 3], [0.0f64; 3]);
-    for bj in 0..h / 4 {
-        for bi in 0..w / 4 {
-            let (mut g, mut t, mut near) = ([0.0f64; 3], [0.0f64; 3], false);
-            for j in bj * 4..bj * 4 + 4 {
-                for i in bi * 4..bi * 4 + 4 {
-                    near |= grid.pixel_dir(i, j).dot(sun) > 3f32.to_radians().cos();
-                    let (a, b) = (got.get(i, j).to_array(), want.get(i, j).to_array());
-                    for c in 0..3 {
-                        g[c] += f64::from(a[c]) * omega[j];
-                        t[c] += f64::from(b[c]) * omega[j];
-                    }
-                }
-            }
-            if !near {
-                for c in 0..3 {
-                    err[c] += (g[c] - t[c]).abs();
-                    sum[c] += t[c];
-                }
-            }
-        }
-    }
-    100.0 * (0..3).map(|c| err[c] / sum[c]).sum::<f64>() / 3.0
-}
-
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    let out = PathBuf::from(args.get(1).map(String::as_str).unwrap_or("target/outdoor-day"));
+    let out = PathBuf::from(
+        args.get(1)
+            .map(String::as_str)
+            .unwrap_or("target/outdoor-day"),
+    );
     let bounces: u32 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(1);
     let samples: usize = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(1500);
     std::fs::create_dir_all(&out).expect("create the output folder");
@@ -82,8 +55,12 @@ fn main() {
     let capture = day.frame_truth(0).expect("truth");
     let probe = day.render_probe(&yard, &capture, 1).expect("probe");
     let frame_size = (day.frame_size.0 as usize, day.frame_size.1 as usize);
-    let grid = VolumeGrid::covering(yard.volume_box.0.as_dvec3(), yard.volume_box.1.as_dvec3(), 3.0)
-        .expect("grid");
+    let grid = VolumeGrid::covering(
+        yard.volume_box.0.as_dvec3(),
+        yard.volume_box.1.as_dvec3(),
+        3.0,
+    )
+    .expect("grid");
     let settings = SystemSettings {
         maps: MapSettings {
             sky_model: SkyModel::Preetham {
@@ -126,12 +103,26 @@ fn main() {
     png(
         &out,
         "normals.png",
-        &maps.normal_map().map(|n| Rgb::new(0.5 + 0.5 * n.r, 0.5 + 0.5 * n.g, 0.5 + 0.5 * n.b)),
+        &maps
+            .normal_map()
+            .map(|n| Rgb::new(0.5 + 0.5 * n.r, 0.5 + 0.5 * n.g, 0.5 + 0.5 * n.b)),
         Some(0.0),
     );
-    png(&out, "weighted_ambient.png", &maps.weighted_ambient_map().map(|&c| Rgb::splat(c)), Some(0.0));
+    png(
+        &out,
+        "weighted_ambient.png",
+        &maps.weighted_ambient_map().map(|&c| Rgb::splat(c)),
+        Some(0.0),
+    );
     let sun0 = Vec3::from_array(capture.parameters.sun_direction);
-    png(&out, "shadow_0930.png", &maps.shadow_map(system.layer(), sun0).map(|&s| Rgb::splat(s)), Some(0.0));
+    png(
+        &out,
+        "shadow_0930.png",
+        &maps
+            .shadow_map(system.layer(), sun0)
+            .map(|&s| Rgb::splat(s)),
+        Some(0.0),
+    );
 
     let mut csv = String::from(
         "frame,local_time,weather,true_sun_r,true_sun_g,true_sun_b,true_sky_r,true_sky_g,true_sky_b,sun_r,sun_g,sun_b,sky_r,sky_g,sky_b,sun_std_g,sky_std_g,sunlit_inliers,inliers,sky_condition,relit_error_percent\n",
@@ -143,30 +134,50 @@ fn main() {
     let exposure = auto_exposure_stops(&probe);
     for k in 0..day.frame_count() {
         let truth = day.frame_truth(k).expect("truth");
-        let frame = day.render_frame(&yard, &truth, 100 + k as u64).expect("frame");
+        let frame = day
+            .render_frame(&yard, &truth, 100 + k as u64)
+            .expect("frame");
         let result = system.process(day.frame_time(k), &frame).expect("process");
         let (e, t) = (result.estimate, truth.parameters);
         let minutes = 9 * 60 + 30 + 30 * k;
         let hour = minutes as f64 / 60.0;
         let relit_error = if k % 3 == 0 || k == 10 {
-            let truth_probe = day.render_probe(&yard, &truth, 1000 + k as u64).expect("probe");
+            let truth_probe = day
+                .render_probe(&yard, &truth, 1000 + k as u64)
+                .expect("probe");
             let sun = Vec3::from_array(t.sun_direction);
-            let err = map_error(system.relit_map(), &truth_probe, sun);
+            let err = map_error(system.relit_map(), &truth_probe, sun, 4);
             let name = format!("{:02}{:02}", minutes / 60, minutes % 60);
             png(&out, &format!("frame_{name}.png"), &frame, Some(exposure));
-            png(&out, &format!("relit_{name}.png"), system.relit_map(), Some(exposure));
-            png(&out, &format!("pathtraced_{name}.png"), &truth_probe, Some(exposure));
+            png(
+                &out,
+                &format!("relit_{name}.png"),
+                system.relit_map(),
+                Some(exposure),
+            );
+            png(
+                &out,
+                &format!("pathtraced_{name}.png"),
+                &truth_probe,
+                Some(exposure),
+            );
             Some(err)
         } else {
             None
         };
         for c in 0..3 {
-            let sun_err = if t.sun[c] > 0.0 { (e.sun[c] / t.sun[c] - 1.0).abs() } else { 0.0 };
+            let sun_err = if t.sun[c] > 0.0 {
+                (e.sun[c] / t.sun[c] - 1.0).abs()
+            } else {
+                0.0
+            };
             let sky_err = (e.sky[c] / t.sky[c] - 1.0).abs();
             match truth.weather {
                 Weather::Clear => worst_clear = worst_clear.max(sun_err).max(sky_err),
                 Weather::Cloud { .. } => worst_cloud = worst_cloud.max(sun_err).max(sky_err),
-                Weather::Overcast => worst_overcast = worst_overcast.max(e.sun[c] / truth.clear_sun[c]),
+                Weather::Overcast => {
+                    worst_overcast = worst_overcast.max(e.sun[c] / truth.clear_sun[c])
+                }
             }
         }
         let weather = match truth.weather {
@@ -178,18 +189,44 @@ fn main() {
             "{k},{:02}:{:02},{weather},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:?},{}\n",
             minutes / 60,
             minutes % 60,
-            t.sun[0], t.sun[1], t.sun[2], t.sky[0], t.sky[1], t.sky[2],
-            e.sun[0], e.sun[1], e.sun[2], e.sky[0], e.sky[1], e.sky[2],
-            e.sun_std[1], e.sky_std[1], e.sunlit_inliers, e.inliers, result.sky_condition,
+            t.sun[0],
+            t.sun[1],
+            t.sun[2],
+            t.sky[0],
+            t.sky[1],
+            t.sky[2],
+            e.sun[0],
+            e.sun[1],
+            e.sun[2],
+            e.sky[0],
+            e.sky[1],
+            e.sky[2],
+            e.sun_std[1],
+            e.sky_std[1],
+            e.sunlit_inliers,
+            e.inliers,
+            result.sky_condition,
             relit_error.map_or(String::new(), |v| format!("{v:.2}")),
         ));
+        let sun_cell = |c: usize| {
+            if t.sun[c] > 0.0 {
+                100.0 * (e.sun[c] / t.sun[c] - 1.0)
+            } else {
+                100.0 * e.sun[c] / truth.clear_sun[c]
+            }
+        };
         let line = format!(
-            "{:02}:{:02} {weather:10} P_d err {:6.2} {:6.2} {:6.2} %  P_a err {:6.2} {:6.2} {:6.2} %{}\n",
+            "{:02}:{:02} {weather:10} P_d {} {:6.2} {:6.2} {:6.2} %  P_a err {:6.2} {:6.2} {:6.2} %{}\n",
             minutes / 60,
             minutes % 60,
-            100.0 * (e.sun[0] / t.sun[0].max(1e-9) - 1.0),
-            100.0 * (e.sun[1] / t.sun[1].max(1e-9) - 1.0),
-            100.0 * (e.sun[2] / t.sun[2].max(1e-9) - 1.0),
+            if t.sun[0] > 0.0 {
+                "err     "
+            } else {
+                "/ clear "
+            },
+            sun_cell(0),
+            sun_cell(1),
+            sun_cell(2),
             100.0 * (e.sky[0] / t.sky[0] - 1.0),
             100.0 * (e.sky[1] / t.sky[1] - 1.0),
             100.0 * (e.sky[2] / t.sky[2] - 1.0),
@@ -214,7 +251,9 @@ fn main() {
     );
     print!("{tail}");
     summary.push_str(&tail);
-    let title = format!("Synthetic day, Aalborg 20 April 2024 (renders with {bounces} bounce(s)): estimates (lines) and truth (dots)");
+    let title = format!(
+        "Synthetic day, Aalborg 20 April 2024 (renders with {bounces} bounce(s)): estimates (lines) and truth (dots)"
+    );
     let svg = estimates_svg(&points, &title, (1100, 700)).expect("plot");
     write_atomically(&out.join("estimates.svg"), svg.as_bytes()).expect("write");
     write_atomically(&out.join("day.csv"), csv.as_bytes()).expect("write");

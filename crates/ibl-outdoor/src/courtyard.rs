@@ -86,24 +86,70 @@ impl Courtyard {
         let asphalt = diffuse(0.22, 0.22, 0.2);
         let far = 200.0;
         let ring = [
-            (Vec3::new(0.0, 0.0, -(far + YARD_HALF) / 2.0), [2.0 * far, far - YARD_HALF]),
-            (Vec3::new(0.0, 0.0, (far + YARD_HALF) / 2.0), [2.0 * far, far - YARD_HALF]),
-            (Vec3::new(-(far + YARD_HALF) / 2.0, 0.0, 0.0), [far - YARD_HALF, 2.0 * YARD_HALF]),
-            (Vec3::new((far + YARD_HALF) / 2.0, 0.0, 0.0), [far - YARD_HALF, 2.0 * YARD_HALF]),
+            (
+                Vec3::new(0.0, 0.0, -(far + YARD_HALF) / 2.0),
+                [2.0 * far, far - YARD_HALF],
+            ),
+            (
+                Vec3::new(0.0, 0.0, (far + YARD_HALF) / 2.0),
+                [2.0 * far, far - YARD_HALF],
+            ),
+            (
+                Vec3::new(-(far + YARD_HALF) / 2.0, 0.0, 0.0),
+                [far - YARD_HALF, 2.0 * YARD_HALF],
+            ),
+            (
+                Vec3::new((far + YARD_HALF) / 2.0, 0.0, 0.0),
+                [far - YARD_HALF, 2.0 * YARD_HALF],
+            ),
         ];
         for (k, (centre, size)) in ring.into_iter().enumerate() {
             // `plane` lays size[0] along its first tangent; for +Y that is the world x axis
             // only up to sign, so build the rectangle from its corners instead.
             let half = Vec3::new(size[0] / 2.0, 0.0, size[1] / 2.0);
-            meshes.push(placed(format!("ground {k}"), quad(centre - half, centre + half), asphalt));
+            meshes.push(placed(
+                format!("ground {k}"),
+                quad(centre - half, centre + half),
+                asphalt,
+            ));
         }
         let boxes = [
-            ("north facade west", [-12.0, 0.0, -20.0], [-4.0, 12.0, -12.0], diffuse(0.46, 0.26, 0.19)),
-            ("north facade middle", [-4.0, 0.0, -20.0], [4.0, 12.0, -12.0], diffuse(0.40, 0.23, 0.17)),
-            ("north facade east", [4.0, 0.0, -20.0], [12.0, 12.0, -12.0], diffuse(0.50, 0.30, 0.22)),
-            ("west block", [-20.0, 0.0, -12.0], [-12.0, 8.0, 8.0], diffuse(0.62, 0.58, 0.50)),
-            ("east block", [12.0, 0.0, -12.0], [18.0, 6.0, 4.0], diffuse(0.38, 0.38, 0.36)),
-            ("kiosk", [1.5, 0.0, -4.5], [5.0, 3.5, -1.5], diffuse(0.55, 0.48, 0.40)),
+            (
+                "north facade west",
+                [-12.0, 0.0, -20.0],
+                [-4.0, 12.0, -12.0],
+                diffuse(0.46, 0.26, 0.19),
+            ),
+            (
+                "north facade middle",
+                [-4.0, 0.0, -20.0],
+                [4.0, 12.0, -12.0],
+                diffuse(0.40, 0.23, 0.17),
+            ),
+            (
+                "north facade east",
+                [4.0, 0.0, -20.0],
+                [12.0, 12.0, -12.0],
+                diffuse(0.50, 0.30, 0.22),
+            ),
+            (
+                "west block",
+                [-20.0, 0.0, -12.0],
+                [-12.0, 8.0, 8.0],
+                diffuse(0.62, 0.58, 0.50),
+            ),
+            (
+                "east block",
+                [12.0, 0.0, -12.0],
+                [18.0, 6.0, 4.0],
+                diffuse(0.38, 0.38, 0.36),
+            ),
+            (
+                "kiosk",
+                [1.5, 0.0, -4.5],
+                [5.0, 3.5, -1.5],
+                diffuse(0.55, 0.48, 0.40),
+            ),
         ];
         for (name, lo, hi, material) in boxes {
             meshes.push(placed(
@@ -169,9 +215,21 @@ mod tests {
     fn the_yard_is_closed_underneath_and_the_camera_sees_it() {
         let yard = Courtyard::new((80, 60));
         // Every downward ray from above the yard and the ring meets the ground.
-        for (x, z) in [(0.0, 0.0), (11.9, -11.9), (50.0, 3.0), (-150.0, -150.0), (5.0, 150.0)] {
+        for (x, z) in [
+            (0.0, 0.0),
+            (11.9, -11.9),
+            (50.0, 3.0),
+            (-150.0, -150.0),
+            (5.0, 150.0),
+        ] {
             let ray = ibl_scene::Ray::new(Vec3::new(x, 30.0, z), Vec3::NEG_Y);
-            assert!(yard.layer.bvh.closest_hit(&ray, 0.0, f32::INFINITY).is_some(), "{x} {z}");
+            assert!(
+                yard.layer
+                    .bvh
+                    .closest_hit(&ray, 0.0, f32::INFINITY)
+                    .is_some(),
+                "{x} {z}"
+            );
         }
         let mask = yard.diffuse_mask((80, 60));
         let seen = mask.pixels().iter().filter(|&&m| m).count();

@@ -156,7 +156,14 @@ impl Sums {
 
     /// `argmin (a, b) >= 0`; `sun` false fits `a` alone with `b = 0`.
     fn solve(&self, sun: bool) -> (f64, f64) {
-        let sky_only = (if self.uu > 0.0 { (self.uy / self.uu).max(0.0) } else { 0.0 }, 0.0);
+        let sky_only = (
+            if self.uu > 0.0 {
+                (self.uy / self.uu).max(0.0)
+            } else {
+                0.0
+            },
+            0.0,
+        );
         if !sun {
             return sky_only;
         }
@@ -168,7 +175,14 @@ impl Sums {
                 return (a, b);
             }
         }
-        let sun_only = (0.0, if self.vv > 0.0 { (self.vy / self.vv).max(0.0) } else { 0.0 });
+        let sun_only = (
+            0.0,
+            if self.vv > 0.0 {
+                (self.vy / self.vv).max(0.0)
+            } else {
+                0.0
+            },
+        );
         if self.objective(sun_only.0, sun_only.1) < self.objective(sky_only.0, sky_only.1) {
             sun_only
         } else {
@@ -207,14 +221,21 @@ pub fn estimate(
     let rows: Vec<Row> = observations
         .iter()
         .filter(|o| {
-            o.albedo.to_array().iter().all(|&a| a >= options.min_albedo && a.is_finite())
+            o.albedo
+                .to_array()
+                .iter()
+                .all(|&a| a >= options.min_albedo && a.is_finite())
                 && o.observed.is_valid_radiance()
                 && o.sky_term.is_valid_radiance()
                 && o.sun_term.is_finite()
                 && o.sun_term >= 0.0
         })
         .map(|o| {
-            let (p, d, c) = (o.observed.to_array(), o.albedo.to_array(), o.sky_term.to_array());
+            let (p, d, c) = (
+                o.observed.to_array(),
+                o.albedo.to_array(),
+                o.sky_term.to_array(),
+            );
             Row {
                 y: [0, 1, 2].map(|k| f64::from(p[k]) / f64::from(d[k])),
                 u: c.map(f64::from),
@@ -346,7 +367,9 @@ pub fn estimate(
                 f64::INFINITY
             };
             if sun_allowed
-                && (sunlit_inliers < options.min_sunlit || !(condition <= options.max_condition))
+                && (sunlit_inliers < options.min_sunlit
+                    || condition.is_nan()
+                    || condition > options.max_condition)
             {
                 sun_allowed = false;
             }
@@ -421,10 +444,15 @@ mod tests {
                     let (a, b): (f32, f32) = (rng.random::<f32>().max(1e-9), rng.random());
                     (-2.0 * a.ln()).sqrt() * (std::f32::consts::TAU * b).cos()
                 };
-                let mut observed = clean * Rgb::new(1.0 + noise * g(), 1.0 + noise * g(), 1.0 + noise * g());
+                let mut observed =
+                    clean * Rgb::new(1.0 + noise * g(), 1.0 + noise * g(), 1.0 + noise * g());
                 if rng.random::<f32>() < outliers {
-                    let f: f32 = if rng.random::<bool>() { rng.random_range(0.2..0.5) } else { rng.random_range(2.0..5.0) };
-                    observed = observed * f;
+                    let f: f32 = if rng.random::<bool>() {
+                        rng.random_range(0.2..0.5)
+                    } else {
+                        rng.random_range(2.0..5.0)
+                    };
+                    observed *= f;
                 }
                 Observation {
                     observed: observed.map(|v| v.max(0.0)),
@@ -469,10 +497,20 @@ mod tests {
         let dirty = synthetic(sun, sky, 500, 0.05, 0.2, 0.5, 3);
         let robust = estimate(&dirty, &EstimatorOptions::default()).unwrap();
         for c in 0..3 {
-            assert!((robust.sun[c] / sun.to_array()[c] - 1.0).abs() < 0.02, "{robust:?}");
-            assert!((robust.sky[c] / sky.to_array()[c] - 1.0).abs() < 0.02, "{robust:?}");
+            assert!(
+                (robust.sun[c] / sun.to_array()[c] - 1.0).abs() < 0.02,
+                "{robust:?}"
+            );
+            assert!(
+                (robust.sky[c] / sky.to_array()[c] - 1.0).abs() < 0.02,
+                "{robust:?}"
+            );
         }
-        assert!(robust.inliers < 440 && robust.inliers > 360, "{}", robust.inliers);
+        assert!(
+            robust.inliers < 440 && robust.inliers > 360,
+            "{}",
+            robust.inliers
+        );
     }
 
     #[test]

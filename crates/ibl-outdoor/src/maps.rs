@@ -42,8 +42,8 @@ use serde::Serialize;
 use crate::OutdoorError;
 use crate::shadow::sun_visibility;
 use crate::sky::{SkyModel, SkyShape};
-use crate::transfer::{AmbientTransfer, SurfacePoint};
 use crate::tracking::{PointLighting, SkyTracker};
+use crate::transfer::{AmbientTransfer, SurfacePoint};
 use crate::view::{ProbeProjection, pixel_footprint};
 use rayon::prelude::*;
 
@@ -309,7 +309,9 @@ impl ProbeMaps {
 
     /// The normal map: unit normals as RGB = XYZ, sky black.
     pub fn normal_map(&self) -> Image<Rgb> {
-        self.image_of(Rgb::ZERO, |k| Rgb::from_array(self.points[k].normal.to_array()))
+        self.image_of(Rgb::ZERO, |k| {
+            Rgb::from_array(self.points[k].normal.to_array())
+        })
     }
 
     /// The weighted-ambient map `c` (sky: 1, it sees itself).
@@ -350,7 +352,7 @@ fn measure_capture(
     let rotation = projection.world_from_probe;
     let mut num = [0.0f64; 3];
     let mut den = [0.0f64; 3];
-    for j in 1..h - 1 {
+    for (j, &omega_j) in omega.iter().enumerate().take(h - 1).skip(1) {
         for i in 0..w {
             let neighbours = [
                 (i, j - 1),
@@ -366,7 +368,7 @@ fn measure_capture(
             {
                 continue;
             }
-            let weight = omega[j] * f64::from(d.y);
+            let weight = omega_j * f64::from(d.y);
             let l = probe.get(i, j).to_array();
             let s = shape.radiance(d).to_array();
             for c in 0..3 {
@@ -375,7 +377,7 @@ fn measure_capture(
             }
         }
     }
-    if den.iter().any(|&v| !(v > 0.0)) {
+    if den.iter().any(|&v| v.is_nan() || v <= 0.0) {
         return Err(OutdoorError::Parameter(
             "the probe shows no open sky to measure the sky parameter from".into(),
         ));
@@ -391,7 +393,7 @@ fn measure_capture(
     }
     let cap = SUN_CAP_RADIUS.max(3.0 * PI / h as f64);
     let mut e_sun = [0.0f64; 3];
-    for j in 0..h {
+    for (j, &omega_j) in omega.iter().enumerate() {
         for i in 0..w {
             let d = rotation * grid.pixel_dir(i, j);
             if !sky(i, j) || d.as_dvec3().dot(sun64).clamp(-1.0, 1.0).acos() > cap {
@@ -400,7 +402,7 @@ fn measure_capture(
             let l = probe.get(i, j).to_array();
             let s = shape.radiance(d).to_array();
             for c in 0..3 {
-                e_sun[c] += (f64::from(l[c]) - pa[c] * f64::from(s[c])) * omega[j];
+                e_sun[c] += (f64::from(l[c]) - pa[c] * f64::from(s[c])) * omega_j;
             }
         }
     }

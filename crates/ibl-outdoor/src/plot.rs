@@ -51,7 +51,11 @@ const CHANNELS: [(&str, RGBColor); 3] = [
 ];
 
 /// The chart of `points` (in time order), `size` in pixels, as an SVG document.
-pub fn estimates_svg(points: &[SeriesPoint], title: &str, size: (u32, u32)) -> Result<String, OutdoorError> {
+pub fn estimates_svg(
+    points: &[SeriesPoint],
+    title: &str,
+    size: (u32, u32),
+) -> Result<String, OutdoorError> {
     if points.is_empty() {
         return Err(OutdoorError::Parameter("no points to plot".into()));
     }
@@ -67,10 +71,7 @@ pub fn estimates_svg(points: &[SeriesPoint], title: &str, size: (u32, u32)) -> R
         });
         let span = (h1 - h0).max(0.5);
         let x_range = (h0 - 0.03 * span)..(h1 + 0.03 * span);
-        for (panel, name, pick) in [
-            (&top, "P_d (sun)", 0usize),
-            (&bottom, "P_a (sky)", 1usize),
-        ] {
+        for (panel, name, pick) in [(&top, "P_d (sun)", 0usize), (&bottom, "P_a (sky)", 1usize)] {
             let value = |p: &SeriesPoint, c: usize| -> (f32, Option<f32>) {
                 if pick == 0 {
                     (p.sun[c], p.truth.map(|t| t.0[c]))
@@ -80,10 +81,12 @@ pub fn estimates_svg(points: &[SeriesPoint], title: &str, size: (u32, u32)) -> R
             };
             let y_max = points
                 .iter()
-                .flat_map(|p| (0..3).flat_map(move |c| {
-                    let (e, t) = value(p, c);
-                    [e, t.unwrap_or(0.0)]
-                }))
+                .flat_map(|p| {
+                    (0..3).flat_map(move |c| {
+                        let (e, t) = value(p, c);
+                        [e, t.unwrap_or(0.0)]
+                    })
+                })
                 .filter(|v| v.is_finite())
                 .fold(0.0f32, f32::max)
                 .max(1e-6) as f64
@@ -99,7 +102,13 @@ pub fn estimates_svg(points: &[SeriesPoint], title: &str, size: (u32, u32)) -> R
                 .configure_mesh()
                 .x_desc(if pick == 1 { "local time (hours)" } else { "" })
                 .y_desc("radiance")
-                .x_label_formatter(&|h| format!("{:02}:{:02}", h.floor() as i32, ((h.fract()) * 60.0).round() as i32))
+                .x_label_formatter(&|h| {
+                    format!(
+                        "{:02}:{:02}",
+                        h.floor() as i32,
+                        ((h.fract()) * 60.0).round() as i32
+                    )
+                })
                 .draw()
                 .map_err(drawing)?;
             for (c, (label, color)) in CHANNELS.iter().enumerate() {
@@ -110,7 +119,9 @@ pub fn estimates_svg(points: &[SeriesPoint], title: &str, size: (u32, u32)) -> R
                     ))
                     .map_err(drawing)?
                     .label(format!("{label} estimate"))
-                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2)));
+                    .legend(move |(x, y)| {
+                        PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2))
+                    });
                 chart
                     .draw_series(points.iter().filter_map(|p| {
                         value(p, c)
@@ -159,7 +170,11 @@ mod tests {
                 sun: [1.0 + k as f32 * 0.1; 3],
                 sky: [0.2; 3],
                 truth: Some(([1.0; 3], [0.21; 3])),
-                label: if k < 3 { "clear".into() } else { "overcast".into() },
+                label: if k < 3 {
+                    "clear".into()
+                } else {
+                    "overcast".into()
+                },
             })
             .collect();
         let svg = estimates_svg(&points, "test day", (900, 600)).unwrap();

@@ -105,8 +105,10 @@ impl SampleSites {
                 }
                 let Some(hit) = view.hit(i, j) else { continue };
                 let flat = (j - 1..=j + 1).all(|b| {
-                    (i - 1..=i + 1)
-                        .all(|a| view.hit(a, b).is_some_and(|o| o.normal.dot(hit.normal) > 0.999))
+                    (i - 1..=i + 1).all(|a| {
+                        view.hit(a, b)
+                            .is_some_and(|o| o.normal.dot(hit.normal) > 0.999)
+                    })
                 });
                 if !flat {
                     continue;
@@ -117,7 +119,9 @@ impl SampleSites {
                 if pj == 0 || pj + 1 >= ph {
                     continue;
                 }
-                let Some((_, s0)) = probe_albedo(pi, pj) else { continue };
+                let Some((_, s0)) = probe_albedo(pi, pj) else {
+                    continue;
+                };
                 // The probe's 3 x 3 neighbourhood: all surface, one capture shadow, albedos
                 // within the tolerance of their mean (which is the site's albedo: a third of
                 // the probe's per-pixel noise).
@@ -231,7 +235,11 @@ impl SampleSites {
     }
 
     /// The observations of `frame` (after [`Self::update`] for the same sun).
-    pub fn observations(&self, frame: &Image<Rgb>, sun: Vec3) -> Result<Vec<Observation>, OutdoorError> {
+    pub fn observations(
+        &self,
+        frame: &Image<Rgb>,
+        sun: Vec3,
+    ) -> Result<Vec<Observation>, OutdoorError> {
         if (frame.width(), frame.height()) != self.frame_size {
             return Err(OutdoorError::Parameter(format!(
                 "the frame is {} x {}; the sites were drawn for {} x {}",

@@ -126,7 +126,7 @@ impl PreethamSky {
             )));
         }
         let sun = sun.as_dvec3().normalize_or_zero();
-        if !(sun.y > 0.0) {
+        if sun.y.is_nan() || sun.y <= 0.0 {
             return Err(OutdoorError::Parameter(format!(
                 "the Preetham sky needs the sun above the horizon (direction {sun})"
             )));
@@ -168,12 +168,9 @@ impl PreethamSky {
     pub fn luminance_chromaticity(&self, d: DVec3) -> [f64; 3] {
         let cos_theta = d.y.max(0.0);
         let gamma = d.dot(self.sun).clamp(-1.0, 1.0).acos();
-        let mut out = [0.0; 3];
-        for q in 0..3 {
-            out[q] = self.zenith[q] * perez(cos_theta, gamma, &self.coefficients[q])
-                / self.normaliser[q];
-        }
-        out
+        std::array::from_fn(|q| {
+            self.zenith[q] * perez(cos_theta, gamma, &self.coefficients[q]) / self.normaliser[q]
+        })
     }
 
     /// Linear Rec.709 radiance towards `d` in kcd m^-2 (luminance units), clamped at 0.
@@ -371,8 +368,8 @@ mod tests {
         let sky = PreethamSky::new(3.0, sun_at(40.0, 0.0)).unwrap();
         // The formulas evaluated independently (Python, f64) for T = 3, theta_s = 40 degrees.
         let want = [8.211436270064887, 0.24770229664367965, 0.2534779496759163];
-        for q in 0..3 {
-            assert!((sky.zenith()[q] - want[q]).abs() < 1e-6 * want[q]);
+        for (got, want) in sky.zenith().iter().zip(want) {
+            assert!((got - want).abs() < 1e-6 * want);
         }
         // At the zenith the Perez ratio is F(0, theta_s) / F(0, theta_s) = 1.
         let at_zenith = sky.luminance_chromaticity(DVec3::Y);
@@ -450,7 +447,10 @@ mod tests {
                 // Two midpoint rules of different grids: measured 2e-5, margin 10x.
                 assert!((v - 1.0).abs() < 2e-4, "{}: {e:?}", model.name());
             }
-            assert_eq!(shape.radiance(Vec3::new(0.0, -0.5, 0.8).normalize()), Rgb::ZERO);
+            assert_eq!(
+                shape.radiance(Vec3::new(0.0, -0.5, 0.8).normalize()),
+                Rgb::ZERO
+            );
         }
     }
 

@@ -54,7 +54,11 @@ impl Scalar {
             *self = Scalar { x: z, var: r };
             return;
         }
-        let k = if self.var + r > 0.0 { self.var / (self.var + r) } else { 1.0 };
+        let k = if self.var + r > 0.0 {
+            self.var / (self.var + r)
+        } else {
+            1.0
+        };
         self.x += k * innovation;
         self.var *= 1.0 - k;
     }
@@ -90,7 +94,11 @@ impl TemporalFilter {
             None => {
                 let init = std::array::from_fn(|k| Scalar {
                     x: z[k].0,
-                    var: if z[k].1.is_finite() { z[k].1 * z[k].1 } else { 0.0 },
+                    var: if z[k].1.is_finite() {
+                        z[k].1 * z[k].1
+                    } else {
+                        0.0
+                    },
                 });
                 self.state = Some(init);
                 self.last_time_s = time_s;

@@ -14,7 +14,8 @@
 //!   a horizontal surface's light, as on a clear day.
 //! - a cloud in front of the sun: the same sky, the sun times `sun_factor`;
 //! - overcast: no sun, the CIE overcast sky with `P_a = (0.30, 0.30, 0.31) (0.4 + 0.6 cos z)`.
-//! Nothing below the horizon (the 400 m ground covers it).
+//!
+//! Nothing comes from below the horizon (the 400 m ground covers it).
 //!
 //! **Renders** (`Lighting::reference`, the MIS path tracer): the probe is the panorama from the
 //! probe centre (its sky pixels are the environment resampled with energy conservation, so the
@@ -167,7 +168,10 @@ impl SyntheticDay {
         let air_mass = 1.0 / (cos_z + 0.50572 * (96.07995 - z_deg).powf(-1.6364));
         let clear_sun = [0.12, 0.16, 0.24].map(|tau: f64| (2.0 * (-tau * air_mass).exp()) as f32);
         let (sun_p, sky_p) = match weather {
-            Weather::Clear => (clear_sun, [0.10, 0.13, 0.19].map(|v: f64| (v * (0.6 + 0.6 * cos_z)) as f32)),
+            Weather::Clear => (
+                clear_sun,
+                [0.10, 0.13, 0.19].map(|v: f64| (v * (0.6 + 0.6 * cos_z)) as f32),
+            ),
             Weather::Cloud { sun_factor } => (
                 clear_sun.map(|v| v * sun_factor),
                 [0.10, 0.13, 0.19].map(|v: f64| (v * (0.6 + 0.6 * cos_z)) as f32),
@@ -214,7 +218,13 @@ impl SyntheticDay {
         Ok(map)
     }
 
-    fn scene(&self, layer: &GeometryLayer, environment: Image<Rgb>, camera: Camera, probe: Vec3) -> Scene {
+    fn scene(
+        &self,
+        layer: &GeometryLayer,
+        environment: Image<Rgb>,
+        camera: Camera,
+        probe: Vec3,
+    ) -> Scene {
         Scene {
             real: layer.clone(),
             virtual_objects: GeometryLayer::empty(),
@@ -251,7 +261,12 @@ impl SyntheticDay {
             position: yard.probe_position,
             world_from_probe: Mat3::IDENTITY,
         };
-        let scene = self.scene(&yard.layer, self.environment(truth)?, camera, yard.probe_position);
+        let scene = self.scene(
+            &yard.layer,
+            self.environment(truth)?,
+            camera,
+            yard.probe_position,
+        );
         let lighting = Lighting::reference(&scene).map_err(ibl_render::RenderError::from)?;
         let out = render(
             &scene,
@@ -269,7 +284,12 @@ impl SyntheticDay {
         truth: &TrueLighting,
         seed: u64,
     ) -> Result<Image<Rgb>, OutdoorError> {
-        let scene = self.scene(&yard.layer, self.environment(truth)?, yard.camera, yard.probe_position);
+        let scene = self.scene(
+            &yard.layer,
+            self.environment(truth)?,
+            yard.camera,
+            yard.probe_position,
+        );
         let lighting = Lighting::reference(&scene).map_err(ibl_render::RenderError::from)?;
         let out = render(
             &scene,
@@ -279,6 +299,43 @@ impl SyntheticDay {
         )?;
         Ok(out.with_objects)
     }
+}
+
+/// The relit-map figure of the validation: the mean absolute error of `got` against `want`
+/// (lat-long maps of the same size) over `block x block` texel blocks, each block's radiance
+/// weighted by its exact solid angle, in per cent of the weighted mean of `want`, averaged over
+/// the channels; blocks with a texel within 3 degrees of `sun` are left out (the sun is a
+/// directional light, not part of the relit map). Blocks average away the renders' per-pixel
+/// noise (by `block` for independent noise).
+pub fn map_error(got: &Image<Rgb>, want: &Image<Rgb>, sun: Vec3, block: usize) -> f64 {
+    let (w, h) = (want.width(), want.height());
+    let grid = LatLong::new(w, h);
+    let omega = grid.row_solid_angles();
+    let block = block.max(1);
+    let near_sun = 3f32.to_radians().cos();
+    let (mut err, mut sum) = ([0.0f64; 3], [0.0f64; 3]);
+    for bj in 0..h / block {
+        for bi in 0..w / block {
+            let (mut g, mut t, mut near) = ([0.0f64; 3], [0.0f64; 3], false);
+            for (j, &omega_j) in omega.iter().enumerate().skip(bj * block).take(block) {
+                for i in bi * block..(bi + 1) * block {
+                    near |= grid.pixel_dir(i, j).dot(sun) > near_sun;
+                    let (a, b) = (got.get(i, j).to_array(), want.get(i, j).to_array());
+                    for c in 0..3 {
+                        g[c] += f64::from(a[c]) * omega_j;
+                        t[c] += f64::from(b[c]) * omega_j;
+                    }
+                }
+            }
+            if !near {
+                for c in 0..3 {
+                    err[c] += (g[c] - t[c]).abs();
+                    sum[c] += t[c];
+                }
+            }
+        }
+    }
+    100.0 * (0..3).map(|c| err[c] / sum[c].max(1e-30)).sum::<f64>() / 3.0
 }
 
 /// Adds a sun disc of irradiance `irradiance` (normal to it) towards `sun` to a lat-long map.
@@ -316,7 +373,7 @@ fn add_sun_disc(map: &mut Image<Rgb>, sun: DVec3, irradiance: Rgb) {
         }
     }
     let total: f64 = covered.iter().map(|&(_, j, f)| f * omega[j]).sum();
-    if !(total > 0.0) {
+    if total.is_nan() || total <= 0.0 {
         return;
     }
     for (i, j, f) in covered {
@@ -345,14 +402,14 @@ mod tests {
         let mut sun_e = [0.0f64; 3];
         let shape = SkyShape::new(SkyModel::Preetham { turbidity: 3.0 }, sun, 1).unwrap();
         let pa = Rgb::from_array(truth.parameters.sky);
-        for j in 0..env.height() {
+        for (j, &omega_j) in omega.iter().enumerate() {
             for i in 0..env.width() {
                 let d = grid.pixel_dir(i, j);
                 let l = env.get(i, j).to_array();
                 let sky = (shape.radiance(d) * pa).to_array();
                 for c in 0..3 {
-                    sky_e[c] += f64::from(sky[c]) * f64::from(d.y.max(0.0)) * omega[j];
-                    sun_e[c] += f64::from(l[c] - sky[c]) * omega[j];
+                    sky_e[c] += f64::from(sky[c]) * f64::from(d.y.max(0.0)) * omega_j;
+                    sun_e[c] += f64::from(l[c] - sky[c]) * omega_j;
                 }
             }
         }
@@ -362,7 +419,10 @@ mod tests {
             let want_sky = PI * f64::from(truth.parameters.sky[c]);
             assert!((sky_e[c] / want_sky - 1.0).abs() < 2e-3, "{sky_e:?}");
             let want_sun = PI * f64::from(truth.parameters.sun[c]);
-            assert!((sun_e[c] / want_sun - 1.0).abs() < 1e-3, "{sun_e:?} {want_sun}");
+            assert!(
+                (sun_e[c] / want_sun - 1.0).abs() < 1e-3,
+                "{sun_e:?} {want_sun}"
+            );
         }
         // Overcast has no sun; clouds dim it.
         assert_eq!(day.frame_truth(10).unwrap().parameters.sun, [0.0; 3]);

@@ -205,7 +205,11 @@ impl OutdoorSystem {
     }
 
     /// Processes the frame taken at `time`.
-    pub fn process(&mut self, time: Timestamp, frame: &Image<Rgb>) -> Result<FrameResult, OutdoorError> {
+    pub fn process(
+        &mut self,
+        time: Timestamp,
+        frame: &Image<Rgb>,
+    ) -> Result<FrameResult, OutdoorError> {
         let sun = self.location.sun_direction(time, self.settings.delta_t)?;
         if sun.y <= 0.0 {
             return Err(OutdoorError::Parameter(format!(
@@ -234,12 +238,15 @@ impl OutdoorSystem {
             None => raw,
         };
         let (pa, pd) = (estimate.sky_rgb(), estimate.sun_rgb());
-        self.relighter.update(&self.layer, &self.maps, &self.sky, sun)?;
+        self.relighter
+            .update(&self.layer, &self.maps, &self.sky, sun)?;
         self.relighter
             .relight_into(&self.maps, sun, pa, pd, &mut self.relit)?;
-        if let (Some(v), Some(gather), Some(volume)) =
-            (self.settings.volume, self.gather.as_mut(), self.volume.as_mut())
-        {
+        if let (Some(v), Some(gather), Some(volume)) = (
+            self.settings.volume,
+            self.gather.as_mut(),
+            self.volume.as_mut(),
+        ) {
             match v.refresh {
                 VolumeRefresh::FromMap => gather.refresh(&self.relit, &self.sky, pa, volume)?,
                 VolumeRefresh::KeyPoints => {

@@ -72,7 +72,11 @@ impl SkyTracker {
 
     /// Switches between the clear and the overcast shape (re-made at once for `sun` when the
     /// condition changes); returns whether it changed.
-    pub fn set_condition(&mut self, condition: SkyCondition, sun: Vec3) -> Result<bool, OutdoorError> {
+    pub fn set_condition(
+        &mut self,
+        condition: SkyCondition,
+        sun: Vec3,
+    ) -> Result<bool, OutdoorError> {
         if condition == self.condition && self.shape.is_some() {
             return Ok(false);
         }

@@ -119,9 +119,7 @@ impl AmbientTransfer {
                         let u2 = (b as f32 + rng.random::<f32>()) / side as f32;
                         let w = cosine_direction(p.normal, u1.min(1.0), u2);
                         if w.y <= 0.0
-                            || layer
-                                .bvh
-                                .occluded(&Ray::new(origin, w), 0.0, f32::INFINITY)
+                            || layer.bvh.occluded(&Ray::new(origin, w), 0.0, f32::INFINITY)
                         {
                             continue;
                         }
@@ -277,7 +275,11 @@ mod tests {
         assert_eq!(t.standard_error(0), 0.0);
         // Stratified: the error is far below the Bernoulli bound sqrt(1/4 / 4096) = 0.0078; the
         // ground seen below the horizon within atan(1 / 500) is 1e-3 of c.
-        assert!((t.weighted_ambient(1) - 0.5).abs() < 0.0078, "{}", t.weighted_ambient(1));
+        assert!(
+            (t.weighted_ambient(1) - 0.5).abs() < 0.0078,
+            "{}",
+            t.weighted_ambient(1)
+        );
         // A uniform sky gives c_shape = c.
         let uniform = SkyShape::new(SkyModel::Uniform, Vec3::Y, 3).unwrap();
         let c = t.sky_ambient(1, &uniform);

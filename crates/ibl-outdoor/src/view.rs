@@ -47,12 +47,7 @@ impl ViewGeometry {
             .into_par_iter()
             .map(|k| {
                 let (i, j) = (k % width, k / width);
-                let ray = camera.ray(
-                    i as f32 + 0.5,
-                    j as f32 + 0.5,
-                    width as u32,
-                    height as u32,
-                );
+                let ray = camera.ray(i as f32 + 0.5, j as f32 + 0.5, width as u32, height as u32);
                 cast(layer, &ray)
             })
             .collect();
@@ -150,7 +145,12 @@ const DEPTH_TOLERANCE: f32 = 0.01;
 impl ProbeProjection {
     /// The probe at `position` with `world_from_probe`, seeing `layer` in a `width x width/2`
     /// lat-long.
-    pub fn new(layer: &GeometryLayer, position: Vec3, world_from_probe: Mat3, width: usize) -> Self {
+    pub fn new(
+        layer: &GeometryLayer,
+        position: Vec3,
+        world_from_probe: Mat3,
+        width: usize,
+    ) -> Self {
         let camera = Camera::Panorama {
             position,
             world_from_probe,
@@ -174,14 +174,15 @@ impl ProbeProjection {
     pub fn pixel_of(&self, point: Vec3) -> Option<(usize, usize)> {
         let offset = point - self.position;
         let distance = offset.length();
-        if !(distance > 0.0) {
+        if distance.is_nan() || distance <= 0.0 {
             return None;
         }
         let (i, j) = self.pixel_towards(offset / distance);
         let hit = self.view.hit(i, j)?;
         // Two pixel footprints at that distance (a lat-long pixel spans pi / H radians).
         let footprint = 2.0 * distance * std::f32::consts::PI / self.view.height() as f32;
-        ((hit.position - point).length() <= DEPTH_TOLERANCE * distance + footprint).then_some((i, j))
+        ((hit.position - point).length() <= DEPTH_TOLERANCE * distance + footprint)
+            .then_some((i, j))
     }
 }
 

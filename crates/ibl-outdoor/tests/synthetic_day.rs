@@ -7,62 +7,21 @@
 //! model with the Preetham sky shape, and every error is estimation error plus render noise;
 //! `docs/OUTDOOR.md` gives the same figures with interreflections (which the model ignores).
 //!
-//! Noise of the truth: frames 160 x 120 at 16 spp, the probe 256 x 128 at 32 spp (per-pixel
-//! relative noise measured by two seeds: about 20 % in shaded frame pixels, 6 % in sunlit ones;
-//! the probe about 10 %). The estimator averages it over 500 samples; the relit-map figure is
-//! taken on 4 x 4 pixel blocks (noise / 4) and its floor (the same metric between two renders of
-//! the truth with different seeds) is checked too.
+//! Noise of the truth: frames 160 x 120 at 48 spp, the probe 256 x 128 at 64 spp. Measured: the
+//! probe's per-pixel noise shows as a 4.8 % median absolute albedo error (the median error, the
+//! bias, is 0.1 %); the estimator averages the frames' noise over its sample sites and reports
+//! its own standard errors (0.3 % for `P_d`, 0.6 to 1.4 % for `P_a` with 1500 sites); the
+//! relit-map figure is taken on 4 x 4 texel blocks and its floor, the same metric between two
+//! renders of the truth with different seeds, is 1.25 % (checked below the figure).
 
 use glam::Vec3;
-use ibl_core::{Image, LatLong, Rgb};
 use ibl_outdoor::courtyard::Courtyard;
-use ibl_outdoor::synthetic::{SyntheticDay, Weather};
+use ibl_outdoor::synthetic::{SyntheticDay, Weather, map_error};
 use ibl_outdoor::{
     CameraSetup, CaptureSource, MapSettings, OutdoorSystem, ProbeCapture, SampleSettings, SkyModel,
     SystemSettings, VolumeRefresh, VolumeSettings,
 };
 use ibl_sh::{LeakControl, VolumeGrid, VolumeLayer};
-
-/// Solid-angle-weighted mean absolute error of `got` against `want` over 4 x 4 blocks, per cent
-/// of the weighted mean of `want`, averaged over channels; texels within 3 degrees of the sun
-/// are left out (the sun is a directional light, not part of the relit map).
-fn map_error(got: &Image<Rgb>, want: &Image<Rgb>, sun: Vec3) -> f64 {
-    let (w, h) = (want.width(), want.height());
-    let grid = LatLong::new(w, h);
-    let omega = grid.row_solid_angles();
-    let block = 4;
-    let mut err = [0.0f64; 3];
-    let mut sum = [0.0f64; 3];
-    for bj in 0..h / block {
-        for bi in 0..w / block {
-            let mut g = [0.0f64; 3];
-            let mut t = [0.0f64; 3];
-            let mut area = 0.0;
-            let mut near_sun = false;
-            for j in bj * block..(bj + 1) * block {
-                for i in bi * block..(bi + 1) * block {
-                    if grid.pixel_dir(i, j).dot(sun) > 3f32.to_radians().cos() {
-                        near_sun = true;
-                    }
-                    let (a, b) = (got.get(i, j).to_array(), want.get(i, j).to_array());
-                    for c in 0..3 {
-                        g[c] += f64::from(a[c]) * omega[j];
-                        t[c] += f64::from(b[c]) * omega[j];
-                    }
-                    area += omega[j];
-                }
-            }
-            if near_sun || area == 0.0 {
-                continue;
-            }
-            for c in 0..3 {
-                err[c] += (g[c] - t[c]).abs();
-                sum[c] += t[c];
-            }
-        }
-    }
-    100.0 * (0..3).map(|c| err[c] / sum[c]).sum::<f64>() / 3.0
-}
 
 #[test]
 fn the_synthetic_day_meets_the_papers_figures() {
@@ -121,8 +80,14 @@ fn the_synthetic_day_meets_the_papers_figures() {
     let measured = system.maps().capture();
     for c in 0..3 {
         let rel = |a: f32, b: f32| (a / b - 1.0).abs();
-        assert!(rel(measured.sun[c], capture.parameters.sun[c]) < 0.01, "{measured:?}");
-        assert!(rel(measured.sky[c], capture.parameters.sky[c]) < 0.01, "{measured:?}");
+        assert!(
+            rel(measured.sun[c], capture.parameters.sun[c]) < 0.01,
+            "{measured:?}"
+        );
+        assert!(
+            rel(measured.sky[c], capture.parameters.sky[c]) < 0.01,
+            "{measured:?}"
+        );
     }
     // Inverse rendering recovers the albedo: over the probe's surface pixels against the
     // materials, the median signed error (the bias) and the median absolute error (the probe's
@@ -146,33 +111,60 @@ fn the_synthetic_day_meets_the_papers_figures() {
     let mut albedo_abs: Vec<f32> = albedo_errors.iter().map(|e| e.abs()).collect();
     albedo_abs.sort_by(f32::total_cmp);
     let albedo_spread = albedo_abs[albedo_abs.len() / 2];
-    println!("albedo: median error {:.2} %, median absolute error {:.2} %", 100.0 * albedo_bias, 100.0 * albedo_spread);
+    println!(
+        "albedo: median error {:.2} %, median absolute error {:.2} %",
+        100.0 * albedo_bias,
+        100.0 * albedo_spread
+    );
     assert_eq!(system.sites().pixels().len(), 1500);
 
-    println!("frame  time   weather    P_d err % (R G B)      P_a err % (R G B)    inliers sunlit  cond  sun_std% sky_std%");
+    println!(
+        "frame  time   weather    P_d err % (R G B)      P_a err % (R G B)    inliers sunlit  cond  sun_std% sky_std%"
+    );
     let mut worst_clear = 0.0f32;
     let mut worst_overcast = 0.0f32;
-    // Every other frame (hourly from 09:30) and the 11:00 cloud keep the test under a minute of
+    // Every other frame (hourly from 09:30), the 11:00 cloud and 17:00 keep the test under a minute of
     // CPU; docs/OUTDOOR.md has all 16 frames (`cargo run --release -p ibl-outdoor --example
     // synthetic_day`).
-    let frames: Vec<usize> = (0..day.frame_count()).filter(|k| k % 2 == 0 || *k == 3).collect();
+    let frames: Vec<usize> = (0..day.frame_count())
+        .filter(|k| k % 2 == 0 || *k == 3 || *k == 15)
+        .collect();
     for k in frames {
         let truth = day.frame_truth(k).unwrap();
         let frame = day.render_frame(&yard, &truth, 100 + k as u64).unwrap();
         let result = system.process(day.frame_time(k), &frame).unwrap();
         let e = result.estimate;
         let t = truth.parameters;
-        let sun_err: Vec<f32> = (0..3).map(|c| 100.0 * (e.sun[c] / t.sun[c] - 1.0)).collect();
-        let sky_err: Vec<f32> = (0..3).map(|c| 100.0 * (e.sky[c] / t.sky[c] - 1.0)).collect();
+        let sun_err: Vec<f32> = (0..3)
+            .map(|c| 100.0 * (e.sun[c] / t.sun[c] - 1.0))
+            .collect();
+        let sky_err: Vec<f32> = (0..3)
+            .map(|c| 100.0 * (e.sky[c] / t.sky[c] - 1.0))
+            .collect();
         let minutes = 9 * 60 + 30 + 30 * k;
         println!(
             "{k:5}  {:02}:{:02}  {:9}  {:6.2} {:6.2} {:6.2}   {:6.2} {:6.2} {:6.2}   {:4} {:4} {:6.1} {:5.2} {:5.2}",
             minutes / 60,
             minutes % 60,
-            format!("{:?}", truth.weather).chars().take(9).collect::<String>(),
-            if t.sun[0] > 0.0 { sun_err[0] } else { 100.0 * e.sun[0] / truth.clear_sun[0] },
-            if t.sun[1] > 0.0 { sun_err[1] } else { 100.0 * e.sun[1] / truth.clear_sun[1] },
-            if t.sun[2] > 0.0 { sun_err[2] } else { 100.0 * e.sun[2] / truth.clear_sun[2] },
+            format!("{:?}", truth.weather)
+                .chars()
+                .take(9)
+                .collect::<String>(),
+            if t.sun[0] > 0.0 {
+                sun_err[0]
+            } else {
+                100.0 * e.sun[0] / truth.clear_sun[0]
+            },
+            if t.sun[1] > 0.0 {
+                sun_err[1]
+            } else {
+                100.0 * e.sun[1] / truth.clear_sun[1]
+            },
+            if t.sun[2] > 0.0 {
+                sun_err[2]
+            } else {
+                100.0 * e.sun[2] / truth.clear_sun[2]
+            },
             sky_err[0],
             sky_err[1],
             sky_err[2],
@@ -195,25 +187,38 @@ fn the_synthetic_day_meets_the_papers_figures() {
             }
             Weather::Cloud { .. } => {}
         }
-        if k == 6 || k == 10 {
+        if k == 6 || k == 10 || k == 15 {
             // The relit map against the path-traced probe at the same time.
             let truth_probe = day.render_probe(&yard, &truth, 1000 + k as u64).unwrap();
             let sun = Vec3::from_array(t.sun_direction);
-            let error = map_error(system.relit_map(), &truth_probe, sun);
+            let error = map_error(system.relit_map(), &truth_probe, sun, 4);
             let floor = if k == 6 {
                 let twin = day.render_probe(&yard, &truth, 2000 + k as u64).unwrap();
-                map_error(&twin, &truth_probe, sun)
+                map_error(&twin, &truth_probe, sun, 4)
             } else {
                 0.0
             };
-            println!("       relit map vs path-traced probe: mean error {error:.2} % (noise floor {floor:.2} %)");
-            assert!(error <= 5.0, "frame {k}: relit map error {error} %");
-            assert!(floor < error, "the metric sees more than the truth's own noise");
+            println!(
+                "       relit map vs path-traced probe: mean error {error:.2} % (noise floor {floor:.2} %)"
+            );
+            // The 5 % holds at midday and when overcast; with the sun low in the west
+            // (17:00) the relit map is further off: measured 7.4 %, a regression bound of 9 %
+            // (docs/OUTDOOR.md states it as below target).
+            let bound = if k == 15 { 9.0 } else { 5.0 };
+            assert!(error <= bound, "frame {k}: relit map error {error} %");
+            assert!(
+                floor < error,
+                "the metric sees more than the truth's own noise"
+            );
             // The volume's irradiance on the ground at the probe's foot against the truth
             // probe's own irradiance there (a sanity check of scale: within 15 %).
             let volume = system.volume().unwrap();
             let at = volume
-                .sample(yard.probe_position, VolumeLayer::AllLight, LeakControl::ValidOnly)
+                .sample(
+                    yard.probe_position,
+                    VolumeLayer::AllLight,
+                    LeakControl::ValidOnly,
+                )
                 .unwrap()
                 .unwrap();
             let e_up = at.irradiance(Vec3::Y)[1];
@@ -226,7 +231,9 @@ fn the_synthetic_day_meets_the_papers_figures() {
             assert!((e_up / (exact - sun_part) - 1.0).abs() < 0.15);
         }
     }
-    println!("worst clear-frame error {worst_clear:.2} %, worst overcast P_d {worst_overcast:.2} % of clear");
+    println!(
+        "worst clear-frame error {worst_clear:.2} %, worst overcast P_d {worst_overcast:.2} % of clear"
+    );
     // The figures: 3 % per channel on clear frames, P_d <= 5 % of clear when overcast.
     assert!(worst_clear <= 3.0, "clear frames: {worst_clear} %");
     assert!(worst_overcast <= 5.0, "overcast: {worst_overcast} %");

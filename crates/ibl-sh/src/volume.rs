@@ -44,7 +44,7 @@ impl VolumeGrid {
     /// A grid; an error for a non-finite origin, a spacing that is not positive and finite, a
     /// zero count or more than [`MAX_KEY_POINTS`] points.
     pub fn new(origin: DVec3, spacing: DVec3, counts: [usize; 3]) -> Result<VolumeGrid, ShError> {
-        if !origin.is_finite() || !(spacing.min_element() > 0.0) || !spacing.is_finite() {
+        if !origin.is_finite() || !spacing.is_finite() || spacing.min_element() <= 0.0 {
             return Err(ShError::Parameter(format!(
                 "volume grid: origin {origin} must be finite and spacing {spacing} positive"
             )));
@@ -67,7 +67,12 @@ impl VolumeGrid {
 
     /// The grid from `min` to `max` (inclusive corners) with at most `spacing` between points.
     pub fn covering(min: DVec3, max: DVec3, spacing: f64) -> Result<VolumeGrid, ShError> {
-        if !(spacing > 0.0) || !min.is_finite() || !max.is_finite() || max.cmplt(min).any() {
+        if spacing.is_nan()
+            || spacing <= 0.0
+            || !min.is_finite()
+            || !max.is_finite()
+            || max.cmplt(min).any()
+        {
             return Err(ShError::Parameter(format!(
                 "volume grid: box {min} to {max} with spacing {spacing}"
             )));
@@ -310,7 +315,7 @@ impl IrradianceVolume {
             out.add_scaled(&data[index], w as f32);
             total += w;
         }
-        if !(total > 0.0) {
+        if total.is_nan() || total <= 0.0 {
             return Ok(None);
         }
         let inv = (1.0 / total) as f32;
@@ -333,7 +338,8 @@ mod tests {
     }
 
     fn volume() -> IrradianceVolume {
-        let grid = VolumeGrid::new(DVec3::new(-1.0, 0.0, -1.0), DVec3::splat(1.0), [3, 2, 3]).unwrap();
+        let grid =
+            VolumeGrid::new(DVec3::new(-1.0, 0.0, -1.0), DVec3::splat(1.0), [3, 2, 3]).unwrap();
         let mut v = IrradianceVolume::new(grid, VolumeLayers::AllAndUnimportant);
         for i in 0..grid.len() {
             let p = grid.position(i);
@@ -367,7 +373,10 @@ mod tests {
             Vec3::new(-1.0, 0.0, -1.0),
             Vec3::new(0.99, 0.5, 0.5),
         ] {
-            let s = v.sample(p, VolumeLayer::AllLight, LeakControl::None).unwrap().unwrap();
+            let s = v
+                .sample(p, VolumeLayer::AllLight, LeakControl::None)
+                .unwrap()
+                .unwrap();
             let e = s.irradiance(Vec3::Y)[0];
             let want = 1.0 + p.x + 2.0 * p.y + 3.0 * p.z + 10.0;
             // f32 sums of eight terms: 1e-5 relative.
@@ -375,7 +384,11 @@ mod tests {
         }
         // Beyond the last point the face value holds: y = 5 reads y = 1.
         let s = v
-            .sample(Vec3::new(0.0, 5.0, 0.0), VolumeLayer::AllLight, LeakControl::None)
+            .sample(
+                Vec3::new(0.0, 5.0, 0.0),
+                VolumeLayer::AllLight,
+                LeakControl::None,
+            )
             .unwrap()
             .unwrap();
         assert!((s.irradiance(Vec3::Y)[0] - 13.0).abs() < 1e-4);
@@ -417,12 +430,19 @@ mod tests {
             .unwrap()
             .unwrap()
             .irradiance(Vec3::Y)[0];
-        assert!((plain - 11.5).abs() < 1e-5 && facing < 11.1, "{facing} {plain}");
+        assert!(
+            (plain - 11.5).abs() < 1e-5 && facing < 11.1,
+            "{facing} {plain}"
+        );
         // All corners invalid: no answer.
         for i in 0..g.len() {
             v.set_valid(i, false);
         }
-        assert!(v.sample(p, VolumeLayer::AllLight, LeakControl::ValidOnly).unwrap().is_none());
+        assert!(
+            v.sample(p, VolumeLayer::AllLight, LeakControl::ValidOnly)
+                .unwrap()
+                .is_none()
+        );
         let single = IrradianceVolume::new(g, VolumeLayers::AllLight);
         assert!(single.layer(VolumeLayer::UnimportantLight).is_err());
     }
