@@ -438,9 +438,10 @@ mod tests {
                 .irradiance(n);
             for (c, v) in e.iter().enumerate() {
                 let want = std::f32::consts::PI * pa.to_array()[c];
-                // Point-sampled Y_lm over exact texel solid angles: the m = 0 bands of a
-                // constant sum to 2e-4 of band 0 at 32 x 16 (measured 1.3e-4).
-                assert!((v / want - 1.0).abs() < 1e-3, "{n}: {v} vs {want}");
+                // Y_lm sampled at texel centres over exact texel solid angles: band 2's m = 0
+                // term of a constant does not sum to exactly 0 at 32 x 16 (measured 2.0e-3 of
+                // the irradiance on +-Y, 1.0e-3 on the horizontal axes), margin 2x.
+                assert!((v / want - 1.0).abs() < 4e-3, "{n}: {v} vs {want}");
             }
         }
         // With a sun, (b) equals (a) to f32 rounding.
