@@ -240,8 +240,8 @@ impl MapGather {
 pub struct KeyPointRelighter {
     sky_response: Vec<IrradianceL2>,
     sun_response: Vec<IrradianceL2>,
-    /// The relighter state the responses were gathered for: (sky generation, shadow casts, sun).
-    made_for: Option<(u64, u32, Vec3)>,
+    /// The relighter state the responses were gathered for: (sky generation, shadow casts).
+    made_for: Option<(u64, u32)>,
 }
 
 impl Default for KeyPointRelighter {
@@ -260,8 +260,10 @@ impl KeyPointRelighter {
         }
     }
 
-    /// Re-gathers the responses when the relighter's shadows or sky shape changed, or the sun
-    /// moved (its cosine); returns whether it did. `relighter` must be updated for `sun`.
+    /// Re-gathers the responses when the relighter's shadows or sky shape changed (the sun moved
+    /// past their thresholds); returns whether it did. In between, `B` keeps the cosines of the
+    /// last gather: the sun moves less than the shadow threshold (0.25 degrees) meanwhile, which
+    /// changes a cosine by less than 0.0044. `relighter` must be updated for `sun`.
     pub fn update(
         &mut self,
         gather: &mut MapGather,
@@ -270,7 +272,7 @@ impl KeyPointRelighter {
         sky: &SkyTracker,
         sun: Vec3,
     ) -> Result<bool, OutdoorError> {
-        let state = (sky.generation(), relighter.lighting().shadow().casts(), sun);
+        let state = (sky.generation(), relighter.lighting().shadow().casts());
         if self.made_for == Some(state) {
             return Ok(false);
         }
