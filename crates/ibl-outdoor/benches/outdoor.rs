@@ -124,19 +124,34 @@ fn bench(c: &mut Criterion) {
     let sun = s.day.sun_direction(s.day.frame_time(6)).expect("sun");
     let mut sky = SkyTracker::new(SkyModel::Preetham { turbidity: 3.0 }, 4, 0.0175);
     sky.update(sun).expect("sky");
+    let mut relighter = Relighter::new(sys.maps(), 0.0044);
+    relighter
+        .update(sys.layer(), sys.maps(), &sky, sun)
+        .expect("relighter");
     let mut sites: SampleSites = sys.sites().clone();
     sites.update(sys.layer(), &sky, sun).expect("sites");
     let options = EstimatorOptions::default();
     group.bench_function("estimate_500_samples", |b| {
         b.iter(|| {
-            let obs = sites.observations(&s.frame, sun).expect("observations");
+            let obs = sites
+                .observations(&s.frame, sun, &relighter)
+                .expect("observations");
             estimate(&obs, &options).expect("estimate")
         })
     });
-    let mut relighter = Relighter::new(sys.maps(), 0.0044);
-    relighter
-        .update(sys.layer(), sys.maps(), &sky, sun)
-        .expect("relighter");
+    // What a frame that re-casts the shadows adds: the probe's footprint shadow rays and the
+    // responses with their interreflection bounces (once per 0.25 degrees of sun, a minute).
+    let mut moved = 0u32;
+    group.bench_function("relighter_recast", |b| {
+        b.iter(|| {
+            moved += 1;
+            let turned = glam::Quat::from_rotation_y((0.3 * moved as f32).to_radians()) * sun;
+            let mut fresh = Relighter::new(sys.maps(), 0.0044);
+            fresh
+                .update(sys.layer(), sys.maps(), &sky, turned)
+                .expect("relighter")
+        })
+    });
     let (pa, pd) = (Rgb::new(0.15, 0.2, 0.3), Rgb::new(1.5, 1.4, 1.2));
     let mut relit = Image::filled(0, 0, Rgb::ZERO);
     group.bench_function("relight_512x256", |b| {

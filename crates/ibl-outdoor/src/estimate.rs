@@ -4,13 +4,15 @@
 //! Each sample `i` is a pixel of the frame on a marked diffuse surface, with its observed
 //! radiance `P_i`, the albedo `d_i` the offline inverse rendering found there, its sky term
 //! `c_i` (the weighted ambient, or `c_shape` for a sky with structure: [`crate::transfer`]) and
-//! its sun term `k_i = s_i max(0, n_i . l)` (shadow times cosine). Per channel the model is
+//! its sun term `k_i = s_i max(0, n_i . l)` (shadow times cosine), and, when the model keeps
+//! interreflections ([`crate::interreflection`]), the light other surfaces reflect onto it per
+//! unit `P_a` and `P_d`, `b_a,i` and `b_d,i`. Per channel the model is
 //!
 //! ```text
-//! P_i = d_i (c_i P_a + k_i P_d)          =>        y_i = P_i / d_i = c_i P_a + k_i P_d
+//! P_i = d_i (c_i P_a + k_i P_d + b_a,i P_a + b_d,i P_d)   =>   y_i = P_i / d_i = u_i P_a + v_i P_d
 //! ```
 //!
-//! linear in the two unknowns, solved by weighted least squares with `P_a, P_d >= 0` (the
+//! (`u = c + b_a`, `v = k + b_d`), linear in the two unknowns, solved by weighted least squares with `P_a, P_d >= 0` (the
 //! two-variable active set: the unconstrained solution, else the better of the two one-variable
 //! fits). Pixel noise (photon, compression, path-tracing) grows with the signal, so each
 //! residual is taken relative to its prediction: weights `1 / max(y_hat_i, f)^2`, `f` 5 % of the
@@ -52,8 +54,14 @@ pub struct Observation {
     pub albedo: Rgb,
     /// Sky term `c` (weighted ambient, or `c_shape`), per channel.
     pub sky_term: Rgb,
-    /// Sun term `s max(0, n . l)`.
+    /// Sun term `s max(0, n . l)` (direct sunlight only: it decides whether the sample is
+    /// sunlit).
     pub sun_term: f32,
+    /// Light reflected onto the sample by other surfaces per unit `P_a`, `b_a` (0 without
+    /// interreflections).
+    pub indirect_sky: Rgb,
+    /// The same per unit `P_d`, `b_d`.
+    pub indirect_sun: Rgb,
 }
 
 /// Options of the robust fit.
@@ -191,11 +199,13 @@ impl Sums {
     }
 }
 
-/// A sample ready for the fit: `y = P / d` and the two columns per channel.
+/// A sample ready for the fit: `y = P / d` and the two columns per channel, and whether it is
+/// in direct sunlight.
 struct Row {
     y: [f64; 3],
     u: [f64; 3],
-    v: f64,
+    v: [f64; 3],
+    sunlit: bool,
 }
 
 fn median(values: &mut [f64]) -> f64 {
@@ -229,6 +239,8 @@ pub fn estimate(
                 && o.sky_term.is_valid_radiance()
                 && o.sun_term.is_finite()
                 && o.sun_term >= 0.0
+                && o.indirect_sky.is_valid_radiance()
+                && o.indirect_sun.is_valid_radiance()
         })
         .map(|o| {
             let (p, d, c) = (
@@ -236,10 +248,12 @@ pub fn estimate(
                 o.albedo.to_array(),
                 o.sky_term.to_array(),
             );
+            let (ba, bd) = (o.indirect_sky.to_array(), o.indirect_sun.to_array());
             Row {
                 y: [0, 1, 2].map(|k| f64::from(p[k]) / f64::from(d[k])),
-                u: c.map(f64::from),
-                v: f64::from(o.sun_term),
+                u: [0, 1, 2].map(|k| f64::from(c[k]) + f64::from(ba[k])),
+                v: [0, 1, 2].map(|k| f64::from(o.sun_term) + f64::from(bd[k])),
+                sunlit: o.sun_term > 0.0,
             }
         })
         .collect();
@@ -252,7 +266,7 @@ pub fn estimate(
         )));
     }
     let n = rows.len();
-    let sunlit_total = rows.iter().filter(|r| r.v > 0.0).count();
+    let sunlit_total = rows.iter().filter(|r| r.sunlit).count();
     let mut sun_allowed = sunlit_total >= options.min_sunlit;
     let mut robust = vec![1.0f64; n];
     let mut params = [(0.0f64, 0.0f64); 3];
@@ -266,14 +280,14 @@ pub fn estimate(
         for (c, p) in next.iter_mut().enumerate() {
             let mut s = Sums::default();
             for ((r, w), h) in rows.iter().zip(&robust).zip(&relative) {
-                s.add(w * h[c], r.u[c], r.v, r.y[c]);
+                s.add(w * h[c], r.u[c], r.v[c], r.y[c]);
             }
             *p = s.solve(sun_allowed);
         }
         // Predictions, relative residuals, robust scale.
         let predictions: Vec<[f64; 3]> = rows
             .iter()
-            .map(|r| [0, 1, 2].map(|c| next[c].0 * r.u[c] + next[c].1 * r.v))
+            .map(|r| [0, 1, 2].map(|c| next[c].0 * r.u[c] + next[c].1 * r.v[c]))
             .collect();
         let floors: [f64; 3] = [0, 1, 2].map(|c| {
             let mut p: Vec<f64> = predictions.iter().map(|p| p[c]).collect();
@@ -295,7 +309,7 @@ pub fn estimate(
             let mut e: Vec<f64> = rows
                 .iter()
                 .zip(&rms)
-                .filter(|(r, _)| (r.v > 0.0) == lit)
+                .filter(|(r, _)| r.sunlit == lit)
                 .map(|(_, e)| *e)
                 .collect();
             (e.len() >= 5).then(|| (median(&mut e) / RMS3_MEDIAN).max(1e-9))
@@ -306,7 +320,7 @@ pub fn estimate(
             shade_sigma.or(lit_sigma).unwrap_or(1e-9),
         ];
         for ((w, e), r) in robust.iter_mut().zip(&rms).zip(&rows) {
-            let u = e / sigma[usize::from(r.v <= 0.0)];
+            let u = e / sigma[usize::from(!r.sunlit)];
             *w = if it < options.huber_iterations {
                 if u <= HUBER_K { 1.0 } else { HUBER_K / u }
             } else if u < TUKEY_C {
@@ -316,7 +330,7 @@ pub fn estimate(
             };
         }
         for ((h, p), r) in relative.iter_mut().zip(&predictions).zip(&rows) {
-            let class = sigma[usize::from(r.v <= 0.0)];
+            let class = sigma[usize::from(!r.sunlit)];
             *h = [0, 1, 2].map(|c| 1.0 / (class * p[c].max(floors[c])).powi(2));
         }
         let change = (0..3)
@@ -335,7 +349,7 @@ pub fn estimate(
     let sunlit_inliers = rows
         .iter()
         .zip(&robust)
-        .filter(|(r, w)| r.v > 0.0 && **w > 0.0)
+        .filter(|(r, w)| r.sunlit && **w > 0.0)
         .count();
     let mut condition = f64::INFINITY;
     let mut sun_std = [f32::INFINITY; 3];
@@ -347,8 +361,8 @@ pub fn estimate(
         let mut rss = 0.0;
         for ((r, w), h) in rows.iter().zip(&robust).zip(&relative) {
             let weight = w * h[c];
-            s.add(weight, r.u[c], r.v, r.y[c]);
-            let res = r.y[c] - params[c].0 * r.u[c] - params[c].1 * r.v;
+            s.add(weight, r.u[c], r.v[c], r.y[c]);
+            let res = r.y[c] - params[c].0 * r.u[c] - params[c].1 * r.v[c];
             rss += weight * res * res;
             wsum += w;
         }
@@ -388,7 +402,7 @@ pub fn estimate(
         for (c, p) in params.iter_mut().enumerate() {
             let mut s = Sums::default();
             for ((r, w), h) in rows.iter().zip(&robust).zip(&relative) {
-                s.add(w * h[c], r.u[c], r.v, r.y[c]);
+                s.add(w * h[c], r.u[c], r.v[c], r.y[c]);
             }
             *p = s.solve(false);
         }
@@ -439,6 +453,9 @@ mod tests {
                 let lit = rng.random::<f32>() < sunlit_fraction;
                 let sun_term = if lit { rng.random_range(0.2..1.0) } else { 0.0 };
                 let clean = albedo * (sky_term * sky + sun * sun_term);
+                // Light from other surfaces, per unit P_a and P_d: none here (see
+                // `with_interreflections`).
+                let (indirect_sky, indirect_sun) = (Rgb::ZERO, Rgb::ZERO);
                 // Box-Muller.
                 let mut g = || {
                     let (a, b): (f32, f32) = (rng.random::<f32>().max(1e-9), rng.random());
@@ -459,6 +476,8 @@ mod tests {
                     albedo,
                     sky_term,
                     sun_term,
+                    indirect_sky,
+                    indirect_sun,
                 }
             })
             .collect()
@@ -530,5 +549,55 @@ mod tests {
         assert!(e.sun_std[0].is_infinite());
         assert!((e.sky[0] / 0.8 - 1.0).abs() < 0.01);
         assert!(estimate(&shade[..2], &EstimatorOptions::default()).is_err());
+    }
+
+    /// Adds light reflected by other surfaces to `observations`: per sample `b_a = 0.3 c` and
+    /// `b_d = 0.25 (0.9, 0.7, 0.5)` (a warm sunlit wall nearby), observed by the pixels; with
+    /// `modelled` the observations also carry the terms.
+    fn with_interreflections(
+        observations: &[Observation],
+        sun: Rgb,
+        sky: Rgb,
+        modelled: bool,
+    ) -> Vec<Observation> {
+        observations
+            .iter()
+            .map(|o| {
+                let ba = o.sky_term * 0.3;
+                let bd = Rgb::new(0.9, 0.7, 0.5) * 0.25;
+                let extra = o.albedo * (ba * sky + bd * sun);
+                let expected = o.albedo * (o.sky_term * sky + sun * o.sun_term);
+                // Keep the sample's relative noise: scale the extra light by observed / clean.
+                let noise = Rgb::new(
+                    o.observed.r / expected.r,
+                    o.observed.g / expected.g,
+                    o.observed.b / expected.b,
+                );
+                Observation {
+                    observed: o.observed + extra * noise,
+                    indirect_sky: if modelled { ba } else { Rgb::ZERO },
+                    indirect_sun: if modelled { bd } else { Rgb::ZERO },
+                    ..*o
+                }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn interreflections_bias_the_paper_model_and_the_bounce_terms_remove_it() {
+        let (sun, sky) = (Rgb::new(3.0, 2.8, 2.5), Rgb::new(0.4, 0.5, 0.7));
+        let base = synthetic(sun, sky, 500, 0.03, 0.0, 0.5, 6);
+        let modelled = with_interreflections(&base, sun, sky, true);
+        let e = estimate(&modelled, &EstimatorOptions::default()).unwrap();
+        for c in 0..3 {
+            // Four standard errors, as above.
+            assert!((e.sun[c] - sun.to_array()[c]).abs() < 4.0 * e.sun_std[c], "{e:?}");
+            assert!((e.sky[c] - sky.to_array()[c]).abs() < 4.0 * e.sky_std[c], "{e:?}");
+        }
+        // Ignored, the shaded samples' bounce light reads as sky: P_a comes out far too high
+        // (the shade's bounce light is 0.25 P_d / (c P_a) ~ 2 to 4 times its sky light).
+        let ignored = with_interreflections(&base, sun, sky, false);
+        let e = estimate(&ignored, &EstimatorOptions::default()).unwrap();
+        assert!(e.sky[1] > 1.5 * sky.g, "{e:?}");
     }
 }

@@ -9,6 +9,8 @@
 //! - [`sky`]: Preetham, CIE overcast and uniform skies, normalised to the sky parameter `P_a`.
 //! - [`view`]: what the probe and the camera see of the model; the probe's projective mapping.
 //! - [`transfer`]: the weighted ambient `c` and the sky transfer vectors behind `c_shape`.
+//! - [`footprint`]: what each probe pixel covers; pixels across the skyline or an edge.
+//! - [`interreflection`]: the light the model's surfaces reflect onto each other.
 //! - [`shadow`]: the binary sun-visibility map and when to re-cast it.
 //! - [`tracking`]: sky shape and per-point terms kept current as the sun moves.
 //! - [`maps`]: the offline maps in the probe's lat-long (normal, weighted ambient, shadow,
@@ -29,6 +31,8 @@
 
 pub mod courtyard;
 pub mod estimate;
+pub mod footprint;
+pub mod interreflection;
 pub mod maps;
 pub mod plot;
 pub mod relight;
@@ -45,6 +49,7 @@ pub mod view;
 pub mod volume_refresh;
 
 pub use estimate::{Estimate, EstimatorOptions, Observation, estimate};
+pub use interreflection::Interreflection;
 pub use maps::{CaptureSource, LightingParameters, MapSettings, ProbeMaps};
 pub use relight::{Relighter, SunLight};
 pub use samples::{SampleSettings, SampleSites};

@@ -22,10 +22,19 @@
 //! the model does not have, such as interreflections) but samples use only albedos in `(0, 1]`.
 //!
 //! The sun term `s_0 max(0, n . l_0)` is the mean over the pixel's footprint, a grid of
-//! `footprint_side^2` sub-pixel rays ([`crate::tracking::PointLighting`]): a probe pixel across a
-//! shadow edge, or a grazing ground pixel that spans metres, is partly sunlit, and a binary
+//! `footprint_side^2` sub-pixel rays whose shadow rays spread over the sun's disc
+//! ([`crate::tracking::PointLighting`], [`crate::shadow`]): a probe pixel across a shadow edge,
+//! in a penumbra, or a grazing ground pixel that spans metres, is partly sunlit, and a binary
 //! value at its centre would give it a wrong albedo (measured on the synthetic day: the relit
-//! map's error against the path-traced probe, with the true lighting, fell from 5.0 % to 3.2 %).
+//! map's error against the path-traced probe, with the true lighting, fell from 5.0 % to 3.2 %
+//! at 12:30 with a 2 x 2 footprint). Only **pure** pixels, whose footprint stays on one plane,
+//! are inverted this way; a pixel across the skyline or a geometric edge takes its albedo from
+//! pure neighbours ([`crate::footprint`]).
+//!
+//! With [`Interreflection::Bounces`] the denominator also holds the light the other surfaces
+//! reflect onto the point, read from the probe itself ([`crate::interreflection`]): `d = P /
+//! (c_shape,0 P_a,0 + k_0 P_d,0 + sum_r G_r P_r)`, so the albedo no longer absorbs the
+//! interreflections of capture time.
 //!
 //! **Normal map**: the unit normal of each surface pixel, facing the probe, as RGB = XYZ (the
 //! paper renders it in two passes with coloured principal lights; ray casting gives it directly).
@@ -40,12 +49,13 @@ use ibl_scene::GeometryLayer;
 use serde::Serialize;
 
 use crate::OutdoorError;
+use crate::footprint::ProbeFootprints;
+use crate::interreflection::{BounceGather, BounceSource, Interreflection};
 use crate::shadow::sun_visibility;
 use crate::sky::{SkyModel, SkyShape};
 use crate::tracking::{PointLighting, SkyTracker};
 use crate::transfer::{AmbientTransfer, SurfacePoint};
-use crate::view::{ProbeProjection, pixel_footprint};
-use rayon::prelude::*;
+use crate::view::ProbeProjection;
 
 /// The sun and sky parameters at one instant, with the sun's direction.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -76,9 +86,12 @@ pub struct MapSettings {
     pub transfer_bands: usize,
     /// Cosine rays per surface pixel for the transfer vectors.
     pub transfer_rays: u32,
-    /// Sub-pixel rays per side of each pixel's footprint for the sun term (2: four shadow rays
-    /// per pixel; 1: the paper's one binary value at the pixel centre).
+    /// Sub-pixel rays per side of each pixel's footprint for the sun term and the detection
+    /// of mixed pixels (4: sixteen shadow rays per pixel; 1: the paper's one binary value at
+    /// the pixel centre).
     pub footprint_side: usize,
+    /// Light reflected between the model's surfaces ([`crate::interreflection`]).
+    pub interreflection: Interreflection,
     /// Seed of the ray jitter.
     pub seed: u64,
 }
@@ -89,7 +102,11 @@ impl Default for MapSettings {
             sky_model: SkyModel::Preetham { turbidity: 3.0 },
             transfer_bands: 8,
             transfer_rays: 256,
-            footprint_side: 2,
+            footprint_side: 4,
+            interreflection: Interreflection::Bounces {
+                bounces: 4,
+                rays: 64,
+            },
             seed: 1,
         }
     }
@@ -107,8 +124,8 @@ pub struct ProbeMaps {
     points: Vec<SurfacePoint>,
     transfer: AmbientTransfer,
     albedo: Vec<Option<Rgb>>,
-    footprints: Vec<SurfacePoint>,
-    footprint_size: usize,
+    footprints: ProbeFootprints,
+    bounce: Option<BounceGather>,
     capture: LightingParameters,
     capture_sun_terms: Vec<f32>,
     probe: Image<Rgb>,
@@ -175,43 +192,42 @@ impl ProbeMaps {
                 measure_capture(probe, &projection, &point_of_pixel, capture_sun, &shape)?
             }
         };
+        settings.interreflection.validate()?;
         let side = settings.footprint_side.clamp(1, 8);
-        let camera = ibl_scene::Camera::Panorama {
-            position,
-            world_from_probe,
-        };
-        let footprints: Vec<SurfacePoint> = pixels
-            .par_iter()
-            .flat_map_iter(|&p| {
-                let centre = projection.view.hits()[p].expect("surface pixel");
-                pixel_footprint(layer, &camera, w, h, p % w, p / w, side, centre)
-                    .into_iter()
-                    .map(|hit| SurfacePoint {
-                        position: hit.position,
-                        normal: hit.normal,
-                    })
-            })
-            .collect();
-        let mut capture_lighting = PointLighting::new(0.0, footprints.clone(), side * side);
+        let footprints = ProbeFootprints::build(layer, &projection, &pixels, &points, side);
+        let mut capture_lighting = PointLighting::new(0.0, footprints.sub_points(), side * side);
         let mut capture_sky = SkyTracker::new(settings.sky_model, settings.transfer_bands, 0.0);
         capture_sky.update(capture_sun)?;
         capture_lighting.update(layer, &points, &transfer, &capture_sky, capture_sun)?;
         let capture_sun_terms: Vec<f32> = (0..points.len())
             .map(|k| capture_lighting.sun_term(k, capture_sun))
             .collect();
+        let bounce = match settings.interreflection {
+            Interreflection::Off => None,
+            Interreflection::Bounces { rays, .. } => Some(BounceGather::build(
+                layer,
+                &points,
+                rays,
+                settings.seed ^ 0xB0B0,
+                |y| bounce_source(&projection, &point_of_pixel, &footprints, y),
+            )?),
+        };
+        // The light other surfaces reflect onto each point at capture time, from the probe.
+        let observed: Vec<Rgb> = pixels.iter().map(|&p| probe.pixels()[p]).collect();
+        let capture_bounce = bounce.as_ref().map(|g| g.gather_all(&observed));
         let (pa, pd) = (Rgb::from_array(capture.sky), Rgb::from_array(capture.sun));
         let albedo = (0..points.len())
             .map(|k| {
                 let c = capture_lighting.sky_terms()[k];
                 let sun_term = capture_sun_terms[k];
-                let denominator = c * pa + pd * sun_term;
-                let observed = probe.pixels()[pixels[k]];
+                let indirect = capture_bounce.as_ref().map_or(Rgb::ZERO, |b| b[k]);
+                let denominator = c * pa + pd * sun_term + indirect;
                 let ok = (0..3).all(|ch| denominator[ch] > MIN_DENOMINATOR * pa[ch]);
                 ok.then(|| {
                     Rgb::new(
-                        observed.r / denominator.r,
-                        observed.g / denominator.g,
-                        observed.b / denominator.b,
+                        observed[k].r / denominator.r,
+                        observed[k].g / denominator.g,
+                        observed[k].b / denominator.b,
                     )
                 })
             })
@@ -225,7 +241,7 @@ impl ProbeMaps {
             transfer,
             albedo,
             footprints,
-            footprint_size: side * side,
+            bounce,
             capture,
             capture_sun_terms,
             probe: probe.clone(),
@@ -284,14 +300,21 @@ impl ProbeMaps {
         &self.capture_sun_terms
     }
 
-    /// Each surface pixel's footprint points, [`Self::footprint_size`] per point in point order.
-    pub fn footprints(&self) -> &[SurfacePoint] {
+    /// Each surface pixel's footprint: its sub-rays, whether it is mixed, its donors.
+    pub fn footprints(&self) -> &ProbeFootprints {
         &self.footprints
     }
 
-    /// Footprint points per surface pixel.
-    pub fn footprint_size(&self) -> usize {
-        self.footprint_size
+    /// The bounce gather of the surface points (`None` when interreflection is off).
+    pub fn bounce(&self) -> Option<&BounceGather> {
+        self.bounce.as_ref()
+    }
+
+    /// Where a ray that met the world point `y` takes its radiance from (see
+    /// [`crate::interreflection`]): the surface point of the probe pixel that saw `y`, or of the
+    /// pixel in its direction when the probe did not, handed to its pure donor when mixed.
+    pub fn bounce_source(&self, y: Vec3) -> BounceSource {
+        bounce_source(&self.projection, &self.point_of_pixel, &self.footprints, y)
     }
 
     /// The probe image.
@@ -324,15 +347,51 @@ impl ProbeMaps {
         self.image_of(0.0, |k| self.transfer.standard_error(k))
     }
 
-    /// The albedo map (sky and unknown pixels black).
+    /// The albedo map (sky and unknown pixels black); a mixed pixel shows its centre donor's.
     pub fn albedo_map(&self) -> Image<Rgb> {
-        self.image_of(Rgb::ZERO, |k| self.albedo[k].unwrap_or(Rgb::ZERO))
+        self.image_of(Rgb::ZERO, |k| {
+            self.albedo[self.footprints.centre_donor(k)].unwrap_or(Rgb::ZERO)
+        })
+    }
+
+    /// The map of mixed pixels (1: the footprint leaves the centre's plane; sky 0).
+    pub fn mixed_map(&self) -> Image<f32> {
+        self.image_of(0.0, |k| f32::from(u8::from(self.footprints.is_mixed(k))))
     }
 
     /// The binary shadow map for a sun towards `sun` (sky: 1).
     pub fn shadow_map(&self, layer: &GeometryLayer, sun: Vec3) -> Image<f32> {
-        let s = sun_visibility(layer, &self.points, sun);
+        let centres: Vec<Option<SurfacePoint>> = self.points.iter().copied().map(Some).collect();
+        let s = sun_visibility(layer, &centres, sun, 1);
         self.image_of(1.0, |k| s[k])
+    }
+}
+
+/// See [`ProbeMaps::bounce_source`].
+fn bounce_source(
+    projection: &ProbeProjection,
+    point_of_pixel: &[u32],
+    footprints: &ProbeFootprints,
+    y: Vec3,
+) -> BounceSource {
+    let w = projection.view.width();
+    let (seen, (i, j)) = match projection.pixel_of(y) {
+        Some(ij) => (true, ij),
+        None => (
+            false,
+            projection.pixel_towards((y - projection.position).normalize_or(Vec3::Y)),
+        ),
+    };
+    match point_of_pixel[j * w + i] {
+        u32::MAX => BounceSource::Lost,
+        k => {
+            let source = footprints.centre_donor(k as usize) as u32;
+            if seen {
+                BounceSource::Seen(source)
+            } else {
+                BounceSource::Unseen(source)
+            }
+        }
     }
 }
 

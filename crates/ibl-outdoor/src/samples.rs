@@ -8,12 +8,16 @@
 //! surfaces of the same normal (no geometric edge), and the probe pixel's 3 x 3 neighbourhood is
 //! all surface with one capture shadow and albedos within `albedo_tolerance` (relative, default
 //! 30 %: the probe's own noise stays inside it, most texture and shadow edges the two views would
-//! sample differently do not). The site's albedo is the mean of those nine, in `[min_albedo, 1]`
-//! (a third of the probe's per-pixel noise). Sites are drawn uniformly without replacement among candidates (seeded), once:
-//! the same pixels are read every frame, so frame-to-frame changes are changes of light. Each
-//! site gets its own sky transfer vector with many rays (default 1024: a standard error of `c`
-//! of at most 1.6 %), its shadow is cast whenever the sun moves past the threshold, and its
-//! observation per frame is the frame's pixel.
+//! sample differently do not), none of them mixed ([`crate::footprint`]). The site's albedo is
+//! the mean of those nine, in `[min_albedo, 1]` (a third of the probe's per-pixel noise). Sites
+//! are drawn uniformly without replacement among candidates (seeded), once: the same pixels are
+//! read every frame, so frame-to-frame changes are changes of light. Each site gets its own sky
+//! transfer vector with many rays (default 1024: a standard error of `c` of at most 1.6 %), its
+//! own footprint of sub-pixel shadow rays over the sun's disc, cast whenever the sun moves past
+//! the threshold, and, when the maps keep interreflections, its own bounce gather onto the
+//! probe's surface points ([`crate::interreflection`]; `interreflection_rays` rays). Its
+//! observation per frame is the frame's pixel, with the bounce terms gathered from the
+//! relighter's current responses.
 
 use glam::Vec3;
 use ibl_core::{Image, Rgb};
@@ -24,7 +28,9 @@ use rand_pcg::Pcg64Mcg;
 
 use crate::OutdoorError;
 use crate::estimate::Observation;
+use crate::interreflection::{BounceGather, Interreflection};
 use crate::maps::ProbeMaps;
+use crate::relight::Relighter;
 use crate::tracking::{PointLighting, SkyTracker};
 use crate::transfer::{AmbientTransfer, SurfacePoint};
 use crate::view::{ViewGeometry, pixel_footprint};
@@ -40,6 +46,8 @@ pub struct SampleSettings {
     pub min_albedo: f32,
     /// Largest relative difference of the probe's 3 x 3 albedos from their mean.
     pub albedo_tolerance: f32,
+    /// Cosine rays per site for its bounce gather (used when the maps keep interreflections).
+    pub interreflection_rays: u32,
     /// Seed of the draw and of the rays.
     pub seed: u64,
 }
@@ -51,6 +59,7 @@ impl Default for SampleSettings {
             transfer_rays: 1024,
             min_albedo: 0.02,
             albedo_tolerance: 0.3,
+            interreflection_rays: 256,
             seed: 7,
         }
     }
@@ -65,6 +74,7 @@ pub struct SampleSites {
     albedo: Vec<Rgb>,
     transfer: AmbientTransfer,
     lighting: PointLighting,
+    bounce: Option<BounceGather>,
     candidates: usize,
 }
 
@@ -93,8 +103,12 @@ impl SampleSites {
         let (pw, ph) = maps.size();
         let albedo = maps.albedo();
         let shadow0 = maps.capture_sun_terms();
+        let footprints = maps.footprints();
         let probe_albedo = |i: usize, j: usize| -> Option<(Rgb, f32)> {
             let k = maps.point_of_pixel(j * pw + i)?;
+            if footprints.is_mixed(k) {
+                return None;
+            }
             albedo[k].map(|a| (a, shadow0[k]))
         };
         let mut candidates: Vec<(usize, usize, SurfacePoint, Rgb)> = Vec::new();
@@ -172,16 +186,17 @@ impl SampleSites {
         chosen.sort_unstable();
         let picked: Vec<_> = chosen.iter().map(|&k| candidates[k]).collect();
         let points: Vec<SurfacePoint> = picked.iter().map(|c| c.2).collect();
-        let side = maps.settings().footprint_side.clamp(1, 8);
-        let footprints: Vec<SurfacePoint> = picked
+        let side = maps.footprints().side();
+        let footprints: Vec<Option<SurfacePoint>> = picked
             .iter()
             .flat_map(|c| {
-                let centre = view.hit(c.0, c.1).copied().expect("a site sees a surface");
-                pixel_footprint(layer, camera, w, h, c.0, c.1, side, centre)
+                pixel_footprint(layer, camera, (w, h), (c.0, c.1), side)
                     .into_iter()
-                    .map(|hit| SurfacePoint {
-                        position: hit.position,
-                        normal: hit.normal,
+                    .map(|ray| {
+                        ray.hit.map(|hit| SurfacePoint {
+                            position: hit.position,
+                            normal: hit.normal,
+                        })
                     })
             })
             .collect();
@@ -192,13 +207,24 @@ impl SampleSites {
             settings.transfer_rays,
             settings.seed ^ 0x5A5A,
         )?;
+        let bounce = match maps.settings().interreflection {
+            Interreflection::Off => None,
+            Interreflection::Bounces { .. } => Some(BounceGather::build(
+                layer,
+                &points,
+                settings.interreflection_rays,
+                settings.seed ^ 0xB0B0,
+                |y| maps.bounce_source(y),
+            )?),
+        };
         Ok(SampleSites {
             frame_size,
             pixels: picked.iter().map(|c| (c.0, c.1)).collect(),
             albedo: picked.iter().map(|c| c.3).collect(),
             points,
             transfer,
-            lighting: PointLighting::new(shadow_threshold_rad, footprints, side * side),
+            lighting: PointLighting::new(shadow_threshold_rad, footprints.into(), side * side),
+            bounce,
             candidates: candidates.len(),
         })
     }
@@ -234,11 +260,18 @@ impl SampleSites {
             .update(layer, &self.points, &self.transfer, sky, sun)
     }
 
-    /// The observations of `frame` (after [`Self::update`] for the same sun).
+    /// The sites' bounce gather (`None` when the maps keep no interreflections).
+    pub fn bounce(&self) -> Option<&BounceGather> {
+        self.bounce.as_ref()
+    }
+
+    /// The observations of `frame` (after [`Self::update`] for the same sun), with the bounce
+    /// terms from `relighter`'s responses (updated for the same sun and sky).
     pub fn observations(
         &self,
         frame: &Image<Rgb>,
         sun: Vec3,
+        relighter: &Relighter,
     ) -> Result<Vec<Observation>, OutdoorError> {
         if (frame.width(), frame.height()) != self.frame_size {
             return Err(OutdoorError::Parameter(format!(
@@ -254,15 +287,35 @@ impl SampleSites {
                 "the sample sites were not updated for a sun direction".into(),
             ));
         }
+        let sources = relighter.sources();
+        if let Some(g) = &self.bounce
+            && (sources.sky_previous.is_empty() || sources.sun_previous.is_empty())
+        {
+            return Err(OutdoorError::Parameter(format!(
+                "the relighter has no responses for the {} sites' bounce gather",
+                g.len()
+            )));
+        }
         Ok(self
             .pixels
             .iter()
             .enumerate()
-            .map(|(k, &(i, j))| Observation {
-                observed: *frame.get(i, j),
-                albedo: self.albedo[k],
-                sky_term: self.lighting.sky_terms()[k],
-                sun_term: self.lighting.sun_term(k, sun),
+            .map(|(k, &(i, j))| {
+                let (indirect_sky, indirect_sun) = match &self.bounce {
+                    Some(g) => (
+                        g.gather(k, &sources.sky_previous),
+                        g.gather(k, &sources.sun_previous),
+                    ),
+                    None => (Rgb::ZERO, Rgb::ZERO),
+                };
+                Observation {
+                    observed: *frame.get(i, j),
+                    albedo: self.albedo[k],
+                    sky_term: self.lighting.sky_terms()[k],
+                    sun_term: self.lighting.sun_term(k, sun),
+                    indirect_sky,
+                    indirect_sun,
+                }
             })
             .collect())
     }

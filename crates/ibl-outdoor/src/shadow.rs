@@ -5,9 +5,21 @@
 //! direct sunlight and 0 where the real scene shades it, "generated anew every time the
 //! relighting algorithm detects that the light direction has changed significantly". Here `s` is
 //! one shadow ray from the point (moved `1e-4` of the scene's extent off the surface) towards
-//! the sun's centre; a point whose normal faces away from the sun is shaded by its own
-//! `max(0, n . l) = 0` whatever `s` is. The sun's disc (0.53 degrees) makes real penumbrae a few
-//! centimetres wide per metre of occluder distance: those points are the estimator's outliers.
+//! the sun; a point whose normal faces away from the sun is shaded by its own `max(0, n . l) =
+//! 0` whatever `s` is.
+//!
+//! **The sun's disc.** The sun is 0.533 degrees across ([`SUN_ANGULAR_RADIUS`]), so a shadow
+//! edge is a penumbra about 1 cm wide per metre from the occluder's edge: 15 cm behind a
+//! building 8 m high at 28 degrees of elevation, the size of a probe pixel there. When points
+//! come in groups (the sub-pixel footprint of one pixel, [`crate::tracking::PointLighting`]), the
+//! `m`-th point of a group of `S` aims its ray at the `m`-th point of a Vogel spiral over the
+//! disc (radius `R sqrt((m + 1/2) / S)`, golden-angle turns, the spiral turned by a golden-ratio
+//! fraction of a turn from one group to the next), so the group's mean of `s` integrates the
+//! visible fraction of the disc over the pixel's footprint at no extra rays. Measured on the
+//! synthetic day (probe pixels shaded at 09:30 and sunlit at 17:00, see docs/OUTDOOR.md): aiming
+//! at the centre leaves penumbra pixels with `s = 0` that the renderer's disc partly lights, and
+//! their albedo comes out several times too high. A group of one aims at the centre, the paper's
+//! binary map.
 //!
 //! [`ShadowState`] keeps the map with the sun direction it was cast for and casts again only
 //! when the sun has moved more than a threshold angle (default 0.25 degrees: the sun moves 0.25
@@ -22,14 +34,49 @@ use crate::transfer::{SurfacePoint, ray_offset};
 /// Default re-cast threshold, radians (0.25 degrees).
 pub const DEFAULT_SHADOW_THRESHOLD_RAD: f32 = 0.25 * std::f32::consts::PI / 180.0;
 
-/// `s` for every point: 1 when the ray towards `sun` (unit) leaves the scene, else 0.
-pub fn sun_visibility(layer: &GeometryLayer, points: &[SurfacePoint], sun: Vec3) -> Vec<f32> {
+/// The sun's mean angular radius, radians (0.2666 degrees: 959.63 arc seconds at 1 AU).
+pub const SUN_ANGULAR_RADIUS: f64 = 0.2666 * std::f64::consts::PI / 180.0;
+
+/// The golden angle, radians: `pi (3 - sqrt 5)`.
+const GOLDEN_ANGLE: f64 = 2.399_963_229_728_653;
+
+/// The direction of the `m`-th of `per_group` shadow rays of group `group` towards the sun's
+/// disc around `sun` (unit): see the module doc. `per_group <= 1` gives the centre.
+pub fn disc_direction(sun: Vec3, group: usize, m: usize, per_group: usize) -> Vec3 {
+    if per_group <= 1 {
+        return sun;
+    }
+    let sun64 = sun.as_dvec3();
+    let (t, b) = ibl_scene::primitives::tangents(sun);
+    let (t, b) = (t.as_dvec3(), b.as_dvec3());
+    let r = SUN_ANGULAR_RADIUS * ((m as f64 + 0.5) / per_group as f64).sqrt();
+    let turn = (group as f64 * 0.618_033_988_749_895).fract() * std::f64::consts::TAU;
+    let phi = m as f64 * GOLDEN_ANGLE + turn;
+    (sun64 * r.cos() + (t * phi.cos() + b * phi.sin()) * r.sin())
+        .normalize()
+        .as_vec3()
+}
+
+/// `s` for every point: 1 when its ray towards the sun leaves the scene, else 0 (and 0 for a
+/// `None`, a sub-pixel ray that sees the sky). `points` come in groups of `per_group` (one
+/// pixel's footprint) whose rays spread over the sun's disc around `sun` (unit); see the module
+/// doc.
+pub fn sun_visibility(
+    layer: &GeometryLayer,
+    points: &[Option<SurfacePoint>],
+    sun: Vec3,
+    per_group: usize,
+) -> Vec<f32> {
     let offset = ray_offset(layer);
+    let per_group = per_group.max(1);
     points
         .par_iter()
-        .map(|p| {
-            let side = if p.normal.dot(sun) >= 0.0 { 1.0 } else { -1.0 };
-            let ray = Ray::new(p.position + p.normal * (side * offset), sun);
+        .enumerate()
+        .map(|(index, p)| {
+            let Some(p) = p else { return 0.0 };
+            let dir = disc_direction(sun, index / per_group, index % per_group, per_group);
+            let side = if p.normal.dot(dir) >= 0.0 { 1.0 } else { -1.0 };
+            let ray = Ray::new(p.position + p.normal * (side * offset), dir);
             if layer.bvh.occluded(&ray, 0.0, f32::INFINITY) {
                 0.0
             } else {
@@ -44,16 +91,19 @@ pub fn sun_visibility(layer: &GeometryLayer, points: &[SurfacePoint], sun: Vec3)
 pub struct ShadowState {
     sun: Option<Vec3>,
     threshold_rad: f32,
+    per_group: usize,
     visibility: Vec<f32>,
     casts: u32,
 }
 
 impl ShadowState {
-    /// No map yet; re-cast when the sun moves more than `threshold_rad`.
-    pub fn new(threshold_rad: f32) -> ShadowState {
+    /// No map yet; re-cast when the sun moves more than `threshold_rad`; points come in groups
+    /// of `per_group` whose rays spread over the sun's disc ([`sun_visibility`]).
+    pub fn new(threshold_rad: f32, per_group: usize) -> ShadowState {
         ShadowState {
             sun: None,
             threshold_rad: threshold_rad.max(0.0),
+            per_group: per_group.max(1),
             visibility: Vec::new(),
             casts: 0,
         }
@@ -61,7 +111,12 @@ impl ShadowState {
 
     /// Makes the map current for `sun`: casts again when there is none or the sun moved more
     /// than the threshold since the last cast. Returns whether it cast.
-    pub fn update(&mut self, layer: &GeometryLayer, points: &[SurfacePoint], sun: Vec3) -> bool {
+    pub fn update(
+        &mut self,
+        layer: &GeometryLayer,
+        points: &[Option<SurfacePoint>],
+        sun: Vec3,
+    ) -> bool {
         let fresh = match self.sun {
             Some(last) if self.visibility.len() == points.len() => {
                 last.dot(sun).clamp(-1.0, 1.0).acos() <= self.threshold_rad
@@ -71,7 +126,7 @@ impl ShadowState {
         if fresh {
             return false;
         }
-        self.visibility = sun_visibility(layer, points, sun);
+        self.visibility = sun_visibility(layer, points, sun, self.per_group);
         self.sun = Some(sun);
         self.casts += 1;
         true
@@ -118,12 +173,14 @@ mod tests {
         ]);
         // Sun 45 degrees up in the south (+Z): the wall's shadow reaches 2 m north (-Z).
         let sun = Vec3::new(0.0, 1.0, 1.0).normalize();
-        let at = |z: f32| SurfacePoint {
-            position: Vec3::new(0.0, 0.0, z),
-            normal: Vec3::Y,
+        let at = |z: f32| {
+            Some(SurfacePoint {
+                position: Vec3::new(0.0, 0.0, z),
+                normal: Vec3::Y,
+            })
         };
         let points = [at(-1.0), at(-1.9), at(-2.2), at(1.0)];
-        let mut state = ShadowState::new(DEFAULT_SHADOW_THRESHOLD_RAD);
+        let mut state = ShadowState::new(DEFAULT_SHADOW_THRESHOLD_RAD, 1);
         assert!(state.update(&layer, &points, sun));
         assert_eq!(state.visibility(), &[0.0, 0.0, 1.0, 1.0]);
         // 0.1 degrees later: kept; 1 degree later: cast again.

@@ -35,11 +35,10 @@ use serde::Serialize;
 use crate::OutdoorError;
 use crate::courtyard::Courtyard;
 use crate::maps::LightingParameters;
+use crate::shadow::SUN_ANGULAR_RADIUS;
 use crate::sky::{SkyModel, SkyShape};
 use crate::sun::{DeltaT, Location, Timestamp};
 
-/// The sun's angular radius, radians (0.2666 degrees).
-pub const SUN_ANGULAR_RADIUS: f64 = 0.2666 * PI / 180.0;
 
 /// The weather of a frame.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]

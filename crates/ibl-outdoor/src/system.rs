@@ -5,10 +5,11 @@
 //! [`OutdoorSystem::new`] and [`OutdoorSystem::process`].
 //!
 //! Order per frame: sun direction (SPA) -> sky shape and shadows if the sun moved past their
-//! thresholds -> observations at the sample sites -> robust estimate (again with the overcast
-//! sky when the sun turns out too weak, or with the clear one when it is back) -> optional temporal
-//! smoothing -> relit map (the smoothed estimate) -> volume refresh, (a) from the relit map or (b)
-//! from the key-point responses.
+//! thresholds, and then the probe's responses (with interreflections) -> observations at the
+//! sample sites (their bounce terms gathered from those responses) -> robust estimate (again
+//! with the overcast sky when the sun turns out too weak, or with the clear one when it is back)
+//! -> optional temporal smoothing -> relit map (the smoothed estimate) -> volume refresh, (a)
+//! from the relit map or (b) from the key-point responses.
 
 use glam::{Mat3, Vec3};
 use ibl_core::{Image, Rgb};
@@ -220,6 +221,8 @@ impl OutdoorSystem {
         let first = *self.first_time.get_or_insert(time);
         let time_s = time.seconds_since(first);
         self.sky.update(sun)?;
+        self.relighter
+            .update(&self.layer, &self.maps, &self.sky, sun)?;
         let mut raw = self.estimate_frame(frame, sun)?;
         if let Some(ratio) = self.settings.overcast_below {
             let overcast = !raw.sun_observable
@@ -230,6 +233,8 @@ impl OutdoorSystem {
                 SkyCondition::Clear
             };
             if self.sky.set_condition(condition, sun)? {
+                self.relighter
+                    .update(&self.layer, &self.maps, &self.sky, sun)?;
                 raw = self.estimate_frame(frame, sun)?;
             }
         }
@@ -238,8 +243,6 @@ impl OutdoorSystem {
             None => raw,
         };
         let (pa, pd) = (estimate.sky_rgb(), estimate.sun_rgb());
-        self.relighter
-            .update(&self.layer, &self.maps, &self.sky, sun)?;
         self.relighter
             .relight_into(&self.maps, sun, pa, pd, &mut self.relit)?;
         if let (Some(v), Some(gather), Some(volume)) = (
@@ -268,7 +271,7 @@ impl OutdoorSystem {
 
     fn estimate_frame(&mut self, frame: &Image<Rgb>, sun: Vec3) -> Result<Estimate, OutdoorError> {
         self.sites.update(&self.layer, &self.sky, sun)?;
-        let observations = self.sites.observations(frame, sun)?;
+        let observations = self.sites.observations(frame, sun, &self.relighter)?;
         estimate(&observations, &self.settings.estimator)
     }
 
@@ -300,5 +303,10 @@ impl OutdoorSystem {
     /// The current sky shape tracker.
     pub fn sky(&self) -> &SkyTracker {
         &self.sky
+    }
+
+    /// The relighter (the probe's current responses).
+    pub fn relighter(&self) -> &Relighter {
+        &self.relighter
     }
 }

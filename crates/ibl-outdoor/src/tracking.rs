@@ -8,6 +8,8 @@
 //! shape's SH expansion are cached. A [`SkyTracker`] counts its shapes (`generation`), so every
 //! cache knows when its sky terms are stale.
 
+use std::sync::Arc;
+
 use glam::Vec3;
 use ibl_core::Rgb;
 use ibl_scene::GeometryLayer;
@@ -110,13 +112,13 @@ impl SkyTracker {
 }
 
 /// The sun-dependent terms of a set of surface points, each seen through a pixel whose
-/// footprint is `per_point` sub-pixel surface points: the sun term is their mean,
-/// `k = (1 / S) sum_j s_j max(0, n_j . l)`, so a pixel across a shadow edge or a geometric edge
-/// gets the fraction of sunlight its footprint receives (the sky term uses the centre's
-/// transfer vector).
+/// footprint is `per_point` sub-pixel rays ([`crate::view::pixel_footprint`]): the sun term is
+/// their mean, `k = (1 / S) sum_j s_j max(0, n_j . l)` (a sub-ray that sees the sky adds 0), so a
+/// pixel across a shadow edge, a penumbra ([`crate::shadow`]) or a geometric edge gets the
+/// fraction of sunlight its footprint receives (the sky term uses the centre's transfer vector).
 #[derive(Clone, Debug)]
 pub struct PointLighting {
-    footprints: Vec<SurfacePoint>,
+    footprints: Arc<[Option<SurfacePoint>]>,
     per_point: usize,
     shadow: ShadowState,
     sky_terms: Vec<Rgb>,
@@ -124,17 +126,18 @@ pub struct PointLighting {
 }
 
 impl PointLighting {
-    /// Empty; `footprints` holds `per_point` sub-points per point, in point order; shadows are
-    /// re-cast when the sun moves more than `shadow_threshold_rad`.
+    /// Empty; `footprints` holds `per_point` sub-points per point, in point order (`None`: a
+    /// sub-ray that sees the sky); shadows are re-cast when the sun moves more than
+    /// `shadow_threshold_rad`.
     pub fn new(
         shadow_threshold_rad: f32,
-        footprints: Vec<SurfacePoint>,
+        footprints: Arc<[Option<SurfacePoint>]>,
         per_point: usize,
     ) -> PointLighting {
         PointLighting {
             footprints,
             per_point: per_point.max(1),
-            shadow: ShadowState::new(shadow_threshold_rad),
+            shadow: ShadowState::new(shadow_threshold_rad, per_point.max(1)),
             sky_terms: Vec::new(),
             sky_generation: 0,
         }
@@ -171,20 +174,53 @@ impl PointLighting {
         &self.sky_terms
     }
 
-    /// `s` per point.
+    /// `s` per sub-point, and the sun it was cast for.
     pub fn shadow(&self) -> &ShadowState {
         &self.shadow
     }
 
+    /// Sub-rays per point.
+    pub fn per_point(&self) -> usize {
+        self.per_point
+    }
+
+    /// The footprint of point `i` (`None`: a sub-ray that sees the sky).
+    pub fn footprint(&self, i: usize) -> &[Option<SurfacePoint>] {
+        &self.footprints[i * self.per_point..(i + 1) * self.per_point]
+    }
+
+    /// `s` of the sub-points of point `i` (after an update).
+    pub fn visibility(&self, i: usize) -> &[f32] {
+        &self.shadow.visibility()[i * self.per_point..(i + 1) * self.per_point]
+    }
+
     /// `k` of point `i` for the sun towards `sun`: the footprint's mean of `s max(0, n . l)`.
     pub fn sun_term(&self, i: usize, sun: Vec3) -> f32 {
-        let s = self.per_point;
-        let vis = &self.shadow.visibility()[i * s..(i + 1) * s];
-        let sum: f32 = self.footprints[i * s..(i + 1) * s]
+        let sum: f32 = self
+            .footprint(i)
             .iter()
-            .zip(vis)
-            .map(|(p, v)| v * p.normal.dot(sun).max(0.0))
+            .zip(self.visibility(i))
+            .map(|(p, v)| p.map_or(0.0, |p| v * p.normal.dot(sun).max(0.0)))
             .sum();
-        sum / s as f32
+        sum / self.per_point as f32
+    }
+
+    /// The sunlit normal sum of point `i`, `(1 / S) sum_j s_j n_j` over the sub-points that
+    /// faced the sun when the shadows were cast: `k = N . l` for any sun near that one (the
+    /// sun term linear in the sun direction between two casts).
+    pub fn sunlit_normal(&self, i: usize) -> Vec3 {
+        let Some(cast_for) = self.shadow.sun() else {
+            return Vec3::ZERO;
+        };
+        let sum: Vec3 = self
+            .footprint(i)
+            .iter()
+            .zip(self.visibility(i))
+            .filter_map(|(p, v)| {
+                p.filter(|p| *v > 0.0 && p.normal.dot(cast_for) > 0.0)
+                    .map(|p| p.normal * *v)
+            })
+            .sum();
+        sum / self.per_point as f32
     }
 }

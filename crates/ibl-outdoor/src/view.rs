@@ -86,21 +86,28 @@ impl ViewGeometry {
     }
 }
 
-/// The surface points of a `side x side` grid of sub-pixel rays through pixel `(i, j)` (at
-/// `(i + (a + 0.5) / side, j + (b + 0.5) / side)`) of a `width x height` image of `camera`; a
-/// sub-ray that meets nothing takes `centre`. Used to integrate the sun term over a pixel's
-/// footprint (shadow edges, grazing ground).
-#[allow(clippy::too_many_arguments)]
+/// One sub-pixel ray of a pixel's footprint: where it goes and what it meets.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FootprintRay {
+    /// Unit world direction of the ray.
+    pub direction: Vec3,
+    /// The surface it meets (`None`: it leaves the model, the sky).
+    pub hit: Option<SurfaceHit>,
+}
+
+/// The `side x side` grid of sub-pixel rays through pixel `(i, j)` (at `(i + (a + 0.5) / side,
+/// j + (b + 0.5) / side)`, row by row) of a `width x height` image of `camera`, with what each
+/// meets. Used to integrate the sun term over a pixel's footprint (shadow edges, grazing ground)
+/// and to find the pixels that straddle two surfaces or a surface and the sky.
 pub fn pixel_footprint(
     layer: &GeometryLayer,
     camera: &Camera,
-    width: usize,
-    height: usize,
-    i: usize,
-    j: usize,
+    size: (usize, usize),
+    pixel: (usize, usize),
     side: usize,
-    centre: SurfaceHit,
-) -> Vec<SurfaceHit> {
+) -> Vec<FootprintRay> {
+    let (width, height) = size;
+    let (i, j) = pixel;
     let mut out = Vec::with_capacity(side * side);
     for b in 0..side {
         for a in 0..side {
@@ -110,7 +117,10 @@ pub fn pixel_footprint(
                 width as u32,
                 height as u32,
             );
-            out.push(cast(layer, &ray).unwrap_or(centre));
+            out.push(FootprintRay {
+                direction: ray.direction,
+                hit: cast(layer, &ray),
+            });
         }
     }
     out

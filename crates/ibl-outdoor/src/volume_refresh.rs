@@ -272,39 +272,26 @@ impl KeyPointRelighter {
         sky: &SkyTracker,
         sun: Vec3,
     ) -> Result<bool, OutdoorError> {
-        let state = (sky.generation(), relighter.lighting().shadow().casts());
+        let Some(state) = relighter.made_for() else {
+            return Err(OutdoorError::Parameter(
+                "the relighter was not updated for these maps".into(),
+            ));
+        };
         if self.made_for == Some(state) {
             return Ok(false);
         }
         gather.update_sky(sky)?;
         let (w, h) = maps.size();
-        let capture_sky = Rgb::from_array(maps.capture().sky);
-        let lighting = relighter.lighting();
-        let terms = lighting.sky_terms();
-        let albedo = maps.albedo();
-        let probe = maps.probe().pixels();
-        let sky_pixels = relighter.sky_pixels();
-        if sky_pixels.len() != w * h || terms.len() != maps.points().len() {
+        let responses = relighter.pixel_responses();
+        if responses.len() != w * h {
             return Err(OutdoorError::Parameter(
                 "the relighter was not updated for these maps".into(),
             ));
         }
         // Per pixel: the response to unit P_a and to unit P_d.
         let response = |p: usize| -> (Rgb, Rgb) {
-            match maps.point_of_pixel(p) {
-                None => (sky_pixels[p], Rgb::ZERO),
-                Some(k) => match albedo[k] {
-                    Some(d) => (d * terms[k], d * lighting.sun_term(k, sun)),
-                    None => (
-                        Rgb::new(
-                            probe[p].r / capture_sky.r.max(1e-30),
-                            probe[p].g / capture_sky.g.max(1e-30),
-                            probe[p].b / capture_sky.b.max(1e-30),
-                        ),
-                        Rgb::ZERO,
-                    ),
-                },
-            }
+            let r = &responses[p];
+            (r.sky, r.sun_response(sun))
         };
         let gathered: Vec<(IrradianceL2, IrradianceL2)> = gather
             .keys
