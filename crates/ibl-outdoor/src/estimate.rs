@@ -591,8 +591,14 @@ mod tests {
         let e = estimate(&modelled, &EstimatorOptions::default()).unwrap();
         for c in 0..3 {
             // Four standard errors, as above.
-            assert!((e.sun[c] - sun.to_array()[c]).abs() < 4.0 * e.sun_std[c], "{e:?}");
-            assert!((e.sky[c] - sky.to_array()[c]).abs() < 4.0 * e.sky_std[c], "{e:?}");
+            assert!(
+                (e.sun[c] - sun.to_array()[c]).abs() < 4.0 * e.sun_std[c],
+                "{e:?}"
+            );
+            assert!(
+                (e.sky[c] - sky.to_array()[c]).abs() < 4.0 * e.sky_std[c],
+                "{e:?}"
+            );
         }
         // Ignored, the shaded samples' bounce light reads as sky: P_a comes out far too high
         // (the shade's bounce light is 0.25 P_d / (c P_a) ~ 2 to 4 times its sky light).

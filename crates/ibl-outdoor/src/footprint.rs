@@ -153,10 +153,7 @@ impl ProbeFootprints {
                 let donors = per_point[k]
                     .0
                     .iter()
-                    .map(|sub| {
-                        sub.and_then(|x| donor_of(i, j, &x))
-                            .unwrap_or(u32::MAX)
-                    })
+                    .map(|sub| sub.and_then(|x| donor_of(i, j, &x)).unwrap_or(u32::MAX))
                     .collect();
                 let centre = donor_of(i, j, &points[k]).unwrap_or(k as u32);
                 (donors, centre)
@@ -263,7 +260,8 @@ mod tests {
                 materials: vec![m],
             },
         ]);
-        let projection = ProbeProjection::new(&layer, Vec3::new(0.0, 1.0, 0.0), Mat3::IDENTITY, 128);
+        let projection =
+            ProbeProjection::new(&layer, Vec3::new(0.0, 1.0, 0.0), Mat3::IDENTITY, 128);
         let pixels = projection.view.surface_pixels();
         let points: Vec<SurfacePoint> = pixels
             .iter()
@@ -282,12 +280,20 @@ mod tests {
         // mixed pixel's surface sub-rays take wall pixels below as donors, the others are sky.
         let col = 64;
         let rows: Vec<usize> = (0..64)
-            .filter(|&j| projection.view.hit(col, j).is_some_and(|h| h.normal.z > 0.9))
+            .filter(|&j| {
+                projection
+                    .view
+                    .hit(col, j)
+                    .is_some_and(|h| h.normal.z > 0.9)
+            })
             .collect();
         let top = *rows.first().unwrap();
         assert_eq!(top, 25);
         let k = pixels.iter().position(|&p| p == top * 128 + col).unwrap();
-        let below = pixels.iter().position(|&p| p == (top + 1) * 128 + col).unwrap();
+        let below = pixels
+            .iter()
+            .position(|&p| p == (top + 1) * 128 + col)
+            .unwrap();
         assert!(f.is_mixed(k), "the skyline pixel");
         assert!(!f.is_mixed(below), "the wall under it");
         let donors: Vec<Option<usize>> = f.donors(k).collect();
@@ -297,7 +303,11 @@ mod tests {
             assert!(!f.is_mixed(d));
             assert!(points[d].normal.z > 0.9, "a wall donor");
         }
-        assert!(f.sky_rays().iter().any(|&(p, d)| p as usize == k && d.y > 0.0));
+        assert!(
+            f.sky_rays()
+                .iter()
+                .any(|&(p, d)| p as usize == k && d.y > 0.0)
+        );
         assert_ne!(f.centre_donor(k), k);
         assert!(f.donors(below).next().is_none());
     }

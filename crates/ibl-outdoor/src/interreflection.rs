@@ -346,7 +346,10 @@ mod tests {
         // the side gap (probability 1e-4 per ray).
         let g0 = f64::from(gather.gather(0, &[Rgb::ONE; 2]).g);
         let g1 = f64::from(gather.gather(1, &[Rgb::ONE; 2]).g);
-        assert!(g0 > 1.0 - 2.0 / 256.0 && g1 > 1.0 - 2.0 / 256.0, "{g0} {g1}");
+        assert!(
+            g0 > 1.0 - 2.0 / 256.0 && g1 > 1.0 - 2.0 / 256.0,
+            "{g0} {g1}"
+        );
         // Albedo 0.5, direct response 1 on the ground only: X_0 = 1 + 0.5 g0 X_1, X_1 = 0.5 g1
         // X_0, so X_0 = 1 / (1 - 0.25 g0 g1); n iterations give the partial sums.
         let albedo = vec![Rgb::splat(0.5); 2];

@@ -39,7 +39,6 @@ use crate::shadow::SUN_ANGULAR_RADIUS;
 use crate::sky::{SkyModel, SkyShape};
 use crate::sun::{DeltaT, Location, Timestamp};
 
-
 /// The weather of a frame.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub enum Weather {
