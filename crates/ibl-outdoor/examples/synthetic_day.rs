@@ -15,9 +15,9 @@
 use std::path::{Path, PathBuf};
 
 use glam::{Mat3, Vec3};
+use ibl_core::tonemap::{Display, ToneCurve, auto_exposure_stops};
 use ibl_core::{Image, Rgb};
-use ibl_io::tonemap::auto_exposure_stops;
-use ibl_io::{Display, ToneCurve, WriteOptions, write_atomically, write_image};
+use ibl_io::{WriteOptions, write_atomically, write_image};
 use ibl_outdoor::courtyard::Courtyard;
 use ibl_outdoor::plot::{SeriesPoint, estimates_svg};
 use ibl_outdoor::synthetic::{SyntheticDay, Weather, map_error};
