@@ -1,7 +1,8 @@
 //! Spherical harmonics for iblkit (CONVENTIONS section 6): the real orthonormal basis of any
 //! order, projection of lat-long probes with exact solid angles, rotation of every band, Lambert
 //! convolution to irradiance (Ramamoorthi & Hanrahan 2001) with optional windowing, and the
-//! radiance and irradiance coefficient sets as distinct types.
+//! radiance and irradiance coefficient sets as distinct types, and irradiance volumes (grids of
+//! L2 irradiance key points, shared by the indoor and outdoor pipelines).
 
 pub mod basis;
 pub mod coefficients;
@@ -9,12 +10,16 @@ pub mod convolution;
 pub mod projection;
 mod quadrature;
 pub mod rotation;
+pub mod volume;
 
 pub use basis::{MAX_BANDS, basis, coefficient_count, eval_basis, sh_index};
 pub use coefficients::{IrradianceSh, RadianceSh};
 pub use convolution::{Window, lambert_factor};
 pub use projection::project_latlong;
 pub use rotation::ShRotation;
+pub use volume::{
+    IrradianceL2, IrradianceVolume, LeakControl, VolumeGrid, VolumeLayer, VolumeLayers,
+};
 
 /// Why an SH operation could not run.
 #[derive(Debug, thiserror::Error, PartialEq)]
