@@ -25,6 +25,9 @@ pub fn is_bad_input(err: &anyhow::Error) -> bool {
         if let Some(e) = cause.downcast_ref::<ibl_io::IoError>() {
             return e.is_bad_input();
         }
+        if let Some(e) = cause.downcast_ref::<ibl_viewer::ViewerError>() {
+            return e.is_bad_input();
+        }
         cause.is::<UsageError>() || cause.is::<ibl_mapping::MappingError>()
     })
 }

@@ -21,7 +21,7 @@ use ibl_io::{Display, ToneCurve, WriteOptions};
 use ibl_mapping::{CubeLayout, Mapping};
 use serde::Serialize;
 
-use crate::cmd::{demo_render, eval, info};
+use crate::cmd::{demo_render, demo_view, eval, info};
 use crate::envmap_files::{self, MappingArg};
 use crate::failure::usage;
 use crate::progress;
@@ -209,7 +209,8 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
         .clone()
         .unwrap_or_else(demo_render::default_scene_dir);
     let renders = demo_render::demo_renders(&scene_dir, &args.out)?;
-    write_summary(&args.out, &results, &report, &renders)?;
+    let views = demo_view::demo_views(&scene_dir, &args.out)?;
+    write_summary(&args.out, &results, &report, &renders, &views)?;
     print_summary(&args.out, &results);
     println!();
     eval::print_lights_needed(&report);
@@ -222,6 +223,14 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
         args.out.display(),
         demo_render::RENDER_DIR
     );
+    match &views.skipped {
+        None => println!(
+            "  {}/{}/             the example scenes in the real-time viewer, with timings",
+            args.out.display(),
+            demo_view::VIEW_DIR
+        ),
+        Some(why) => println!("  viewer frames skipped: {why}"),
+    }
     Ok(())
 }
 
@@ -450,15 +459,18 @@ fn write_summary(
     results: &[ProbeResult],
     report: &ibl_eval::Report,
     renders: &[demo_render::SceneResult],
+    views: &demo_view::ViewSection,
 ) -> anyhow::Result<()> {
     #[derive(Serialize)]
     struct Summary<'a> {
         probes: &'a [ProbeResult],
         renders: &'a [demo_render::SceneResult],
+        views: &'a demo_view::ViewSection,
     }
     let json = serde_json::to_string_pretty(&Summary {
         probes: results,
         renders,
+        views,
     })?;
     std::fs::write(out.join("summary.json"), json)
         .with_context(|| format!("{}: cannot write summary.json", out.display()))?;
@@ -526,6 +538,7 @@ fn write_summary(
     }
     html.push_str(&eval_html(report));
     html.push_str(&demo_render::renders_html(renders));
+    html.push_str(&demo_view::views_html(views));
     std::fs::write(out.join("index.html"), html)
         .with_context(|| format!("{}: cannot write index.html", out.display()))?;
     Ok(())
