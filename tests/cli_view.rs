@@ -22,7 +22,11 @@ fn in_ci() -> bool {
 /// Whether `out` failed for want of a GPU adapter (then the test is skipped, or fails in CI).
 fn no_adapter(out: &Output, test: &str) -> bool {
     let missing = out.status.code() == Some(1) && stderr(out).contains("no usable GPU adapter");
-    assert!(!(missing && in_ci()), "{test}: no GPU adapter under CI: {}", stderr(out));
+    assert!(
+        !(missing && in_ci()),
+        "{test}: no GPU adapter under CI: {}",
+        stderr(out)
+    );
     if missing {
         eprintln!("{test}: SKIPPED, no GPU adapter");
     }
@@ -30,7 +34,11 @@ fn no_adapter(out: &Output, test: &str) -> bool {
 }
 
 fn scene(name: &str) -> String {
-    repo().join("assets/scenes").join(name).display().to_string()
+    repo()
+        .join("assets/scenes")
+        .join(name)
+        .display()
+        .to_string()
 }
 
 #[test]
@@ -56,7 +64,10 @@ fn headless_frames_are_written_with_their_timings() {
     let v: Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["kind"], "scene");
     assert_eq!(v["frames"], 3);
-    assert_eq!((v["width"].as_u64(), v["height"].as_u64()), (Some(160), Some(120)));
+    assert_eq!(
+        (v["width"].as_u64(), v["height"].as_u64()),
+        (Some(160), Some(120))
+    );
     assert_eq!(v["lights"], 16, "the scene's 16 median-cut lights");
     assert!(v["adapter"]["name"].as_str().is_some());
     let frames = v["per_frame"].as_array().unwrap();
@@ -71,7 +82,9 @@ fn headless_frames_are_written_with_their_timings() {
     assert_eq!(frames[2]["real_shadows_drawn"], false);
     assert!(v["statistics"]["fps_median"].as_f64().unwrap() > 0.0);
     assert!(png.exists() && dir.path().join("frame.exr").exists());
-    let frame = ibl_io::read_image(&dir.path().join("frame.exr")).unwrap().image;
+    let frame = ibl_io::read_image(&dir.path().join("frame.exr"))
+        .unwrap()
+        .image;
     assert_eq!((frame.width(), frame.height()), (160, 120));
 }
 
@@ -95,7 +108,10 @@ fn the_benchmark_moves_the_object_every_frame() {
     let v: Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["motion"], "orbit");
     for f in v["per_frame"].as_array().unwrap() {
-        assert_eq!(f["virtual_shadows_drawn"], true, "the object moved: its shadows are redrawn");
+        assert_eq!(
+            f["virtual_shadows_drawn"], true,
+            "the object moved: its shadows are redrawn"
+        );
     }
     let s = &v["statistics"];
     assert!(s["fps_p95"].as_f64().unwrap() <= s["fps_median"].as_f64().unwrap());
@@ -143,20 +159,69 @@ fn refuses(args: &[&str], needle: &str) {
 fn bad_input_is_refused_with_status_2() {
     let dir = tempfile::tempdir().unwrap();
     let missing = dir.path().join("missing.toml");
-    refuses(&["view", missing.to_str().unwrap(), "--headless"], "missing.toml");
-    refuses(&["view", &scene("bunny-sky.toml"), "--headless", "--size", "0x10"], "--size");
-    refuses(&["view", &scene("bunny-sky.toml"), "--headless", "--size", "wide"], "--size");
+    refuses(
+        &["view", missing.to_str().unwrap(), "--headless"],
+        "missing.toml",
+    );
+    refuses(
+        &[
+            "view",
+            &scene("bunny-sky.toml"),
+            "--headless",
+            "--size",
+            "0x10",
+        ],
+        "--size",
+    );
+    refuses(
+        &[
+            "view",
+            &scene("bunny-sky.toml"),
+            "--headless",
+            "--size",
+            "wide",
+        ],
+        "--size",
+    );
     let txt = dir.path().join("frame.txt");
-    refuses(&["view", &scene("bunny-sky.toml"), "--headless", "-o", txt.to_str().unwrap()], "frame.txt");
-    refuses(&["view", &scene("bunny-sky.toml"), "-o", "x.png"], "--headless");
+    refuses(
+        &[
+            "view",
+            &scene("bunny-sky.toml"),
+            "--headless",
+            "-o",
+            txt.to_str().unwrap(),
+        ],
+        "frame.txt",
+    );
+    refuses(
+        &["view", &scene("bunny-sky.toml"), "-o", "x.png"],
+        "--headless",
+    );
     let broken = dir.path().join("broken.toml");
-    std::fs::write(&broken, "version = 1\n[probe]\nfile = \"p.exr\"\n[render]\nspp = 0\n").unwrap();
-    refuses(&["view", broken.to_str().unwrap(), "--headless"], "render.spp");
+    std::fs::write(
+        &broken,
+        "version = 1\n[probe]\nfile = \"p.exr\"\n[render]\nspp = 0\n",
+    )
+    .unwrap();
+    refuses(
+        &["view", broken.to_str().unwrap(), "--headless"],
+        "render.spp",
+    );
     // The frame would overwrite the probe it shows: refused before any work.
     let probe = dir.path().join("probe.exr");
     std::fs::copy(repo().join("assets/probes/night.exr"), &probe).unwrap();
     let before = std::fs::read(&probe).unwrap();
-    refuses(&["view", probe.to_str().unwrap(), "--headless", "-o", probe.to_str().unwrap()], "overwrite");
+    refuses(
+        &[
+            "view",
+            probe.to_str().unwrap(),
+            "--headless",
+            "-o",
+            probe.to_str().unwrap(),
+        ],
+        "overwrite",
+    );
     assert_eq!(std::fs::read(&probe).unwrap(), before);
 }
 
@@ -169,12 +234,23 @@ fn with_display() -> Option<Command> {
     let xvfb = Command::new("xvfb-run").arg("--help").output().is_ok();
     xvfb.then(|| {
         let mut c = Command::new("xvfb-run");
-        c.args(["-a", "-s", "-screen 0 1280x800x24", env!("CARGO_BIN_EXE_ibl")]);
+        c.args([
+            "-a",
+            "-s",
+            "-screen 0 1280x800x24",
+            env!("CARGO_BIN_EXE_ibl"),
+        ]);
         c
     })
 }
 
-fn distinct_colours(image: &ibl_core::Image<ibl_core::Rgb>, x0: usize, x1: usize, y0: usize, y1: usize) -> usize {
+fn distinct_colours(
+    image: &ibl_core::Image<ibl_core::Rgb>,
+    x0: usize,
+    x1: usize,
+    y0: usize,
+    y1: usize,
+) -> usize {
     let mut colours = std::collections::BTreeSet::new();
     for y in (y0..y1).step_by(3) {
         for x in (x0..x1).step_by(3) {
@@ -188,14 +264,23 @@ fn distinct_colours(image: &ibl_core::Image<ibl_core::Rgb>, x0: usize, x1: usize
 #[test]
 fn the_window_opens_under_xvfb_and_its_screenshot_shows_the_scene_and_the_ui() {
     let Some(mut command) = with_display() else {
-        assert!(!in_ci(), "CI must install xvfb and xauth for the window test");
+        assert!(
+            !in_ci(),
+            "CI must install xvfb and xauth for the window test"
+        );
         eprintln!("window: SKIPPED, no display and no xvfb-run");
         return;
     };
     let dir = tempfile::tempdir().unwrap();
     let shot: PathBuf = dir.path().join("window.png");
     let out = command
-        .args(["view", &scene("bunny-sky.toml"), "--size", "400x300", "--screenshot"])
+        .args([
+            "view",
+            &scene("bunny-sky.toml"),
+            "--size",
+            "400x300",
+            "--screenshot",
+        ])
         .arg(&shot)
         .output()
         .unwrap();

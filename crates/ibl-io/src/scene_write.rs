@@ -38,7 +38,12 @@ pub fn edited_scene_text(
     let old = serialize(original)?;
     let mut new = serialize(edited)?;
     shorten_floats(new.as_item_mut());
-    merge_table(document.as_item_mut(), Some(old.as_item()), new.as_item(), true);
+    merge_table(
+        document.as_item_mut(),
+        Some(old.as_item()),
+        new.as_item(),
+        true,
+    );
     Ok(document.to_string())
 }
 
@@ -154,7 +159,10 @@ fn merge_item(doc: &mut Item, old: Option<&Item>, new: &Item) {
         let count = n.len();
         for (i, new_table) in n.iter().enumerate() {
             let new_item = Item::Table(new_table.clone());
-            let old_item = o.as_ref().and_then(|o| o.get(i)).map(|t| Item::Table(t.clone()));
+            let old_item = o
+                .as_ref()
+                .and_then(|o| o.get(i))
+                .map(|t| Item::Table(t.clone()));
             match d.get_mut(i) {
                 Some(table) => {
                     let mut item = Item::Table(std::mem::take(table));
@@ -218,10 +226,16 @@ material = { kind = "diffuse", albedo = [0.75, 0.75, 0.75] }
         let text = edited_scene_text(SCENE, &original, &edited).expect("writes");
         assert!(text.contains("# A comment that must survive."), "{text}");
         assert!(text.contains("# relative to this file"), "{text}");
-        assert!(text.contains("translate = [0.25, -0.777, -1.5]  # on the ground"), "{text}");
+        assert!(
+            text.contains("translate = [0.25, -0.777, -1.5]  # on the ground"),
+            "{text}"
+        );
         assert!(text.contains("rotate_deg = [30.0, 0.0, 0.0]"), "{text}");
         assert!(!text.contains("0.7770000"), "{text}");
-        assert!(!text.contains("radiance_scale"), "defaults stay out: {text}");
+        assert!(
+            !text.contains("radiance_scale"),
+            "defaults stay out: {text}"
+        );
         let back = SceneDescription::from_toml(&text).expect("reads back");
         assert_eq!(back, edited);
     }

@@ -6,7 +6,10 @@
 //! right; images row 0 at the top; continuous image coordinates put pixel (i, j)'s centre at
 //! `(i + 0.5, j + 0.5)`. Modules:
 //!
-//! * [`mapping`]: the [`Mapping`] enum, names, shapes, sizes, per-pixel geometry.
+//! * [`mapping`]: the [`Mapping`] enum, names, shapes, sizes.
+//! * [`projection`]: a mapping bound to an image size ([`Projection`]): per-pixel directions and
+//!   densities, their inverse, bilinear look-ups ([`Taps`], [`taps`]), exact texel solid angles;
+//!   what the renderer and the viewer sample with.
 //! * [`cube`]: GL/KTX cube faces, cross and strip layouts, split/join of faces.
 //! * [`disc`]: angular map, mirror ball and the radial machinery (exact clipped solid angles).
 //! * [`fisheye`]: equidistant single and dual fisheye, the dual's feathered blend.
@@ -16,13 +19,18 @@
 
 pub mod cube;
 pub mod disc;
+mod error;
 pub mod fisheye;
 pub mod mapping;
 pub mod power;
-mod projection;
+pub mod projection;
 pub mod resample;
+pub mod taps;
 
 pub use cube::{CUBE_FACE_NAMES, join_cube_faces, split_cube_faces};
-pub use mapping::{CubeLayout, MAPPING_NAMES, Mapping, MappingError};
+pub use error::MappingError;
+pub use mapping::{CubeLayout, MAPPING_NAMES, Mapping};
 pub use power::{power, try_power};
+pub use projection::Projection;
 pub use resample::{resample, rotate};
+pub use taps::Taps;

@@ -1,7 +1,7 @@
 //! The display transform on the GPU (`display_pass.wgsl`): exposure in stops, the tone curves of
 //! `ibl preview` (clamp, Reinhard, ACES filmic) and the sRGB encoding, applied per pixel to the
 //! float radiance of a frame; then the overlay drawn over it. Same formulas as
-//! `ibl_io::tonemap` (CONVENTIONS section 6), so a frame saved as PNG by the viewer matches
+//! `ibl_core::tonemap` (CONVENTIONS section 6), so a frame saved as PNG by the viewer matches
 //! `ibl preview` of the frame's EXR to within one 8-bit code.
 
 use bytemuck::{Pod, Zeroable};

@@ -159,7 +159,9 @@ impl EnvironmentMaps {
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("environment maps"),
         });
-        let full_source = source.texture.create_view(&wgpu::TextureViewDescriptor::default());
+        let full_source = source
+            .texture
+            .create_view(&wgpu::TextureViewDescriptor::default());
         let draw = |encoder: &mut wgpu::CommandEncoder,
                     pipeline: &wgpu::RenderPipeline,
                     target: &wgpu::TextureView,
@@ -273,7 +275,11 @@ mod tests {
         // delta_1 = 4 pi / 512; the half-maximum angle of e_1 is 1.5 texels of level 1.
         let half_max = (0.5f32.powf(1.0 / e1)).acos();
         let texel = 4.0 * std::f32::consts::PI / 512.0;
-        assert!((half_max / texel - 1.5).abs() < 0.01, "{}", half_max / texel);
+        assert!(
+            (half_max / texel - 1.5).abs() < 0.01,
+            "{}",
+            half_max / texel
+        );
         // Level 0 (the probe itself) stands for exponent 4 e_1 and sharper.
         assert_eq!(glossy_level(e1, 7, e1 * 4.0), 0.0);
         assert_eq!(glossy_level(e1, 7, e1 * 100.0), 0.0);

@@ -103,8 +103,14 @@ impl FrameTargets {
         let readable = sampled | wgpu::TextureUsages::COPY_SRC;
         let view = |t: &wgpu::Texture| t.create_view(&wgpu::TextureViewDescriptor::default());
         let msaa_radiance = texture(gpu, "msaa radiance", size, HDR_FORMAT, MSAA_SAMPLES, attach);
-        let msaa_coverage =
-            texture(gpu, "msaa coverage", size, COVERAGE_FORMAT, MSAA_SAMPLES, attach);
+        let msaa_coverage = texture(
+            gpu,
+            "msaa coverage",
+            size,
+            COVERAGE_FORMAT,
+            MSAA_SAMPLES,
+            attach,
+        );
         let msaa_depth = texture(gpu, "msaa depth", size, DEPTH_FORMAT, MSAA_SAMPLES, attach);
         let radiance = texture(gpu, "radiance", size, HDR_FORMAT, 1, readable);
         let coverage = texture(gpu, "coverage", size, COVERAGE_FORMAT, 1, readable);
@@ -140,7 +146,10 @@ impl FrameTargets {
             })
             .collect();
         let coverage: Vec<f32> = coverage.iter().map(|&c| f32::from(c) / 255.0).collect();
-        let display: Vec<[u8; 3]> = display.chunks_exact(4).map(|t| [t[0], t[1], t[2]]).collect();
+        let display: Vec<[u8; 3]> = display
+            .chunks_exact(4)
+            .map(|t| [t[0], t[1], t[2]])
+            .collect();
         let image_error = |e: ibl_core::image::ImageError| ViewerError::Gpu(e.to_string());
         Ok(FrameImages {
             radiance: Image::from_vec(w, h, radiance).map_err(image_error)?,

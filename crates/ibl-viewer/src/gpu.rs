@@ -45,7 +45,9 @@ impl AdapterSummary {
             name: info.name.clone(),
             backend: info.backend.to_str().to_string(),
             device_type: device_type.to_string(),
-            driver: format!("{} {}", info.driver, info.driver_info).trim().to_string(),
+            driver: format!("{} {}", info.driver, info.driver_info)
+                .trim()
+                .to_string(),
         }
     }
 
@@ -109,19 +111,25 @@ impl GpuContext {
     pub fn headless() -> Result<GpuContext, ViewerError> {
         let instance =
             wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
-        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
-            power_preference: wgpu::PowerPreference::from_env()
-                .unwrap_or(wgpu::PowerPreference::HighPerformance),
-            force_fallback_adapter: false,
-            compatible_surface: None,
-            apply_limit_buckets: false,
-        }))
-        .map_err(|e| ViewerError::NoAdapter(e.to_string()))?;
+        let adapter =
+            pollster::block_on(
+                instance.request_adapter(&wgpu::RequestAdapterOptions {
+                    power_preference: wgpu::PowerPreference::from_env()
+                        .unwrap_or(wgpu::PowerPreference::HighPerformance),
+                    force_fallback_adapter: false,
+                    compatible_surface: None,
+                    apply_limit_buckets: false,
+                }),
+            )
+            .map_err(|e| ViewerError::NoAdapter(e.to_string()))?;
         Self::open(instance, adapter)
     }
 
     /// Opens `adapter` (from `instance`) with [`device_descriptor`].
-    pub fn open(instance: wgpu::Instance, adapter: wgpu::Adapter) -> Result<GpuContext, ViewerError> {
+    pub fn open(
+        instance: wgpu::Instance,
+        adapter: wgpu::Adapter,
+    ) -> Result<GpuContext, ViewerError> {
         let info = adapter.get_info();
         check_adapter(&adapter).map_err(|why| {
             ViewerError::NoAdapter(format!("{} cannot be used: {why}", info.name))
@@ -152,7 +160,8 @@ impl GpuContext {
 
     /// The errors reported since the last call, as one [`ViewerError::Gpu`] (`Ok` when none).
     pub fn take_errors(&self) -> Result<(), ViewerError> {
-        let errors = std::mem::take(&mut *self.errors.lock().unwrap_or_else(PoisonError::into_inner));
+        let errors =
+            std::mem::take(&mut *self.errors.lock().unwrap_or_else(PoisonError::into_inner));
         match errors.first() {
             None => Ok(()),
             Some(first) if errors.len() == 1 => Err(ViewerError::Gpu(first.clone())),

@@ -160,7 +160,11 @@ pub struct GpuScene {
 fn mesh(gpu: &GpuContext, label: &str, vertices: &[crate::scene_geometry::Vertex]) -> MeshBuffer {
     // wgpu refuses empty buffers: one degenerate vertex stands in (never drawn).
     let dummy = [crate::scene_geometry::Vertex::zeroed()];
-    let data: &[crate::scene_geometry::Vertex] = if vertices.is_empty() { &dummy } else { vertices };
+    let data: &[crate::scene_geometry::Vertex] = if vertices.is_empty() {
+        &dummy
+    } else {
+        vertices
+    };
     MeshBuffer {
         buffer: gpu
             .device

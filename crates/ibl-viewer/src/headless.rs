@@ -11,7 +11,7 @@
 use std::time::Instant;
 
 use glam::Vec3;
-use ibl_io::Display;
+use ibl_core::tonemap::Display;
 use serde::Serialize;
 
 use crate::ViewerError;
@@ -128,7 +128,11 @@ pub struct HeadlessRun {
 }
 
 fn statistics(frames: &[FrameTiming]) -> RunStatistics {
-    let steady = if frames.len() > 1 { &frames[1..] } else { frames };
+    let steady = if frames.len() > 1 {
+        &frames[1..]
+    } else {
+        frames
+    };
     let wall: Vec<f64> = steady.iter().map(|f| f.wall_seconds).collect();
     let cpu: Vec<f64> = steady.iter().map(|f| f.cpu_seconds).collect();
     let gpu: Vec<f64> = steady.iter().filter_map(|f| f.gpu_seconds).collect();
@@ -160,9 +164,10 @@ pub fn scene_camera(model: &SceneModel, width: u32, height: u32) -> OutputCamera
 
 /// The orbit a benchmark flies: about the objects' centre at the starting camera's distance.
 fn bench_orbit(model: &SceneModel, start: &OutputCamera) -> OrbitControl {
-    let target = model
-        .objects_sphere()
-        .map_or(start.position + start.ray(0.5 * start.size.0 as f32, 0.5 * start.size.1 as f32), |(c, _)| c);
+    let target = model.objects_sphere().map_or(
+        start.position + start.ray(0.5 * start.size.0 as f32, 0.5 * start.size.1 as f32),
+        |(c, _)| c,
+    );
     let offset = start.position - target;
     let distance = offset.length().max(0.1);
     OrbitControl::from_view(start.position, -offset, distance, start.vertical_fov())
@@ -266,9 +271,9 @@ pub fn render_scene(
 /// The exposure `ibl render` previews a scene with: automatic from its background.
 pub fn auto_exposure(model: &SceneModel) -> f32 {
     match &model.scene.background {
-        ibl_scene::Background::Photo(photo) => ibl_io::tonemap::auto_exposure_stops(photo),
+        ibl_scene::Background::Photo(photo) => ibl_core::tonemap::auto_exposure_stops(photo),
         ibl_scene::Background::Panorama => {
-            ibl_io::tonemap::auto_exposure_stops(&model.scene.probe.radiance)
+            ibl_core::tonemap::auto_exposure_stops(&model.scene.probe.radiance)
         }
     }
 }
@@ -299,7 +304,11 @@ pub fn render_probe(
         })
         .map_err(|e| ViewerError::Lighting(format!("{}: {e}", model.path.display())))?;
         lights = overlay.set.lights.len();
-        lighting = format!("{lights} {} lights, SH{} irradiance", settings.spec, settings.bands * settings.bands);
+        lighting = format!(
+            "{lights} {} lights, SH{} irradiance",
+            settings.spec,
+            settings.bands * settings.bands
+        );
         renderer.set_overlay(gpu, overlay);
     }
     let lighting_seconds = started.elapsed().as_secs_f64();
@@ -309,7 +318,8 @@ pub fn render_probe(
     for k in 0..frames {
         if options.motion == Motion::Orbit {
             view.orbit = settings.orbit;
-            view.orbit.turn(std::f32::consts::TAU * k as f32 / frames as f32, 0.0);
+            view.orbit
+                .turn(std::f32::consts::TAU * k as f32 / frames as f32, 0.0);
         }
         let started = Instant::now();
         let cpu_seconds = renderer.render(gpu, &view, 1.0);

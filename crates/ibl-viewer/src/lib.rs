@@ -54,6 +54,7 @@ pub mod shadow_atlas;
 pub mod textures;
 pub mod timing;
 pub mod view_camera;
+pub mod view_job;
 pub mod view_state;
 pub mod window;
 pub mod worker;
@@ -61,5 +62,8 @@ pub mod worker;
 pub use error::ViewerError;
 pub use gpu::GpuContext;
 pub use headless::{HeadlessOptions, HeadlessRun, Motion};
+/// The sphere mappings a probe file may be in (what [`ProbeModel::open`] and the window take).
+pub use ibl_mapping::Mapping;
 pub use probe_model::{ProbeModel, ProbeViewSettings};
 pub use scene_model::SceneModel;
+pub use view_job::{ViewJob, ViewSummary};

@@ -158,7 +158,10 @@ impl AtlasLayout {
 
     /// Top-left texel of tile `i`.
     pub fn origin(&self, i: u32) -> (u32, u32) {
-        ((i % self.columns) * self.tile, (i / self.columns) * self.tile)
+        (
+            (i % self.columns) * self.tile,
+            (i / self.columns) * self.tile,
+        )
     }
 
     /// Tile `i` in atlas texture coordinates: `(u0, v0, du, dv)` (top left and size).
@@ -216,7 +219,12 @@ mod tests {
 
     #[test]
     fn box_depths_bound_every_corner() {
-        let (t, a) = box_depths(Vec3::Y, Vec3::ZERO, Vec3::splat(-1.0), Vec3::new(1.0, 2.0, 1.0));
+        let (t, a) = box_depths(
+            Vec3::Y,
+            Vec3::ZERO,
+            Vec3::splat(-1.0),
+            Vec3::new(1.0, 2.0, 1.0),
+        );
         assert_eq!((t, a), (2.0, 1.0));
     }
 
@@ -227,7 +235,10 @@ mod tests {
         assert_eq!(a.size(), (4096, 4096));
         let b = AtlasLayout::new(64, 1024, 16384);
         assert_eq!((b.columns, b.rows), (8, 8));
-        assert_eq!(b.tile, 512, "64 tiles of 1024 exceed the 4096^2 texel budget");
+        assert_eq!(
+            b.tile, 512,
+            "64 tiles of 1024 exceed the 4096^2 texel budget"
+        );
         let c = AtlasLayout::new(3, 2048, 2048);
         assert_eq!((c.columns, c.rows, c.tile), (2, 2, 1024));
         assert_eq!(c.origin(3), (1024, 1024));

@@ -2,7 +2,7 @@
 //! the UI thread ([`crate::worker`]).
 //!
 //! - **Scene lighting**: a scene's `[lighting]` becomes lights through
-//!   `ibl_render::lighting::LightingPlan::build`, the same call `ibl render` makes, so the viewer
+//!   `ibl_pipeline::LightingPlan::build`, the same call `ibl render` makes, so the viewer
 //!   draws exactly the CPU renderer's directional lights (rotated by `world_from_probe`, black
 //!   lights dropped, each with its cone of solid angle `A_i`). The hybrid mode's SH ambient (the
 //!   probe minus the lights as point sources, Madsen & Laursen 2006 section 5) is evaluated into
@@ -19,9 +19,11 @@ use std::sync::Arc;
 
 use glam::DVec3;
 use ibl_core::{Image, LatLong, Rgb};
-use ibl_extract::{DominantLight, ExtractOptions, LightSet, ModelSpec, build_model};
-use ibl_render::lighting::{DirectionalLight, LightingPlan};
+use ibl_extract::{DominantLight, ExtractOptions, ModelSpec, build_model};
+use ibl_light::LightSet;
+use ibl_pipeline::LightingPlan;
 use ibl_render::Illumination;
+use ibl_render::lighting::DirectionalLight;
 use ibl_scene::Scene;
 use ibl_sh::IrradianceSh;
 
@@ -63,7 +65,11 @@ pub fn scene_lighting(request: &SceneLightingRequest) -> Result<SceneLighting, S
         Illumination::Environment => return Err("the reference mode has no lights".into()),
     };
     let plan = &request.plan;
-    let mut summary = format!("{} {} lights", list.lights.len(), set.method);
+    let mut summary = format!(
+        "{} {} lights",
+        list.lights.len(),
+        set.provenance.extraction.name()
+    );
     if let Some(sh) = ambient {
         summary += &format!(" + SH{} ambient", sh.bands() * sh.bands());
     }
@@ -173,8 +179,8 @@ pub fn region_borders(set: &LightSet, width: usize, height: usize) -> Option<Ima
 }
 
 /// The direction of a light of `set` in the world, for a probe rotated by `world_from_probe`.
-pub fn world_direction(direction: [f64; 3], world_from_probe: glam::Mat3) -> glam::Vec3 {
-    (world_from_probe.as_dmat3() * DVec3::from_array(direction))
+pub fn world_direction(direction: DVec3, world_from_probe: glam::Mat3) -> glam::Vec3 {
+    (world_from_probe.as_dmat3() * direction)
         .normalize()
         .as_vec3()
 }
@@ -202,7 +208,10 @@ mod tests {
         let mut worst = 0.0f64;
         for k in 0..997 {
             // Directions between texel centres, where interpolation errs most.
-            let (u, v) = ((k as f64 * 0.618_034) % 1.0, 0.02 + 0.96 * (k as f64 * 0.414_214) % 0.96);
+            let (u, v) = (
+                (k as f64 * 0.618_034) % 1.0,
+                0.02 + 0.96 * (k as f64 * 0.414_214) % 0.96,
+            );
             let d = LatLong::uv_to_dir64(u, v);
             let exact = sh.irradiance(d)[1];
             let (x, y) = (u * w - 0.5, v * h - 0.5);
@@ -223,13 +232,13 @@ mod tests {
     #[test]
     fn region_borders_outline_each_region() {
         let set = LightSet {
-            method: "test".into(),
-            lights: vec![ibl_extract::Light {
-                direction: [0.0, 1.0, 0.0],
+            provenance: ibl_light::Provenance::extracted(ibl_light::Extraction::AdaptiveMedianCut),
+            lights: vec![ibl_light::Light {
+                direction: DVec3::Y,
                 radiance: Rgb::ONE,
                 solid_angle_sr: 1.0,
-                irradiance: [1.0; 3],
-                region: Some(ibl_extract::PixelRegion {
+                irradiance: ibl_core::rgb::Rgb64::new(1.0, 1.0, 1.0),
+                region: Some(ibl_light::PixelRegion {
                     x0: 2,
                     y0: 1,
                     x1: 6,

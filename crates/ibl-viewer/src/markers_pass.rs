@@ -143,7 +143,11 @@ impl MarkersPass {
                     usage,
                 })
         };
-        let screen = init("screen", bytemuck::cast_slice(&screen), wgpu::BufferUsages::UNIFORM);
+        let screen = init(
+            "screen",
+            bytemuck::cast_slice(&screen),
+            wgpu::BufferUsages::UNIFORM,
+        );
         let markers_buffer = init(
             "markers",
             bytemuck::cast_slice(&data),

@@ -3,10 +3,11 @@
 //! empty or failed view.
 
 use eframe::egui;
-use ibl_extract::{LightSource, Method, ModelSpec};
-use ibl_io::ToneCurve;
-use ibl_scene::description::{CompositeRule, MaterialDescription, MaterialKind, RenderMode};
+use ibl_core::tonemap::ToneCurve;
+use ibl_extract::ModelSpec;
+use ibl_light::{LightSource, Method};
 use ibl_scene::ShadowKind;
+use ibl_scene::description::{CompositeRule, MaterialDescription, MaterialKind, RenderMode};
 
 use crate::probe_pass::{ProbeLayer, ProbeProjection};
 use crate::scene_renderer::GlossySource;
@@ -62,7 +63,7 @@ fn curve_name(c: ToneCurve) -> &'static str {
     }
 }
 
-fn display_controls(ui: &mut egui::Ui, display: &mut ibl_io::Display, automatic: f32) {
+fn display_controls(ui: &mut egui::Ui, display: &mut ibl_core::tonemap::Display, automatic: f32) {
     ui.horizontal(|ui| {
         ui.add(
             egui::Slider::new(&mut display.exposure_stops, -24.0..=24.0)
@@ -97,12 +98,24 @@ fn probe_panel(ui: &mut egui::Ui, p: &mut ProbeState) {
     ui.separator();
     ui.label("View");
     ui.horizontal(|ui| {
-        ui.selectable_value(&mut p.settings.projection, ProbeProjection::LookAround, "look around");
-        ui.selectable_value(&mut p.settings.projection, ProbeProjection::LatLong, "lat-long");
+        ui.selectable_value(
+            &mut p.settings.projection,
+            ProbeProjection::LookAround,
+            "look around",
+        );
+        ui.selectable_value(
+            &mut p.settings.projection,
+            ProbeProjection::LatLong,
+            "lat-long",
+        );
     });
     ui.horizontal(|ui| {
         ui.selectable_value(&mut p.settings.layer, ProbeLayer::Radiance, "radiance");
-        ui.selectable_value(&mut p.settings.layer, ProbeLayer::ShIrradiance, "SH irradiance / pi");
+        ui.selectable_value(
+            &mut p.settings.layer,
+            ProbeLayer::ShIrradiance,
+            "SH irradiance / pi",
+        );
     });
     let mut fov = p.settings.orbit.vertical_fov.to_degrees();
     if ui
@@ -113,7 +126,11 @@ fn probe_panel(ui: &mut egui::Ui, p: &mut ProbeState) {
     }
     ui.horizontal(|ui| {
         for (k, name) in ["+X", "-X", "+Y", "-Y", "+Z", "-Z"].iter().enumerate() {
-            if ui.button(*name).on_hover_text(format!("key {}", k + 1)).clicked() {
+            if ui
+                .button(*name)
+                .on_hover_text(format!("key {}", k + 1))
+                .clicked()
+            {
                 let (yaw, pitch) = crate::view_state::axis_view(k);
                 p.settings.orbit.yaw = yaw;
                 p.settings.orbit.pitch = pitch;
@@ -124,7 +141,7 @@ fn probe_panel(ui: &mut egui::Ui, p: &mut ProbeState) {
     ui.add(egui::Slider::new(&mut p.settings.sharpen, 0.0..=2.0).text("Laplacian sharpening"));
     ui.separator();
     ui.label("Display");
-    let automatic = ibl_io::tonemap::auto_exposure_stops(&p.model.latlong);
+    let automatic = ibl_core::tonemap::auto_exposure_stops(&p.model.latlong);
     display_controls(ui, &mut p.settings.display, automatic);
     ui.separator();
     ui.label("Lights");
@@ -160,7 +177,9 @@ fn probe_panel(ui: &mut egui::Ui, p: &mut ProbeState) {
     if let Some((d, l)) = p.cursor {
         let elevation = d.y.clamp(-1.0, 1.0).asin().to_degrees();
         let azimuth = d.x.atan2(-d.z).to_degrees();
-        ui.label(format!("cursor: azimuth {azimuth:.1}, elevation {elevation:.1} deg"));
+        ui.label(format!(
+            "cursor: azimuth {azimuth:.1}, elevation {elevation:.1} deg"
+        ));
         ui.label(format!(
             "radiance {:.4} {:.4} {:.4} (luminance {:.4})",
             l.r,
@@ -183,7 +202,11 @@ fn light_source_controls(ui: &mut egui::Ui, spec: &mut ModelSpec, lights: &mut u
         });
     let mut n = *lights as u32;
     if ui
-        .add(egui::Slider::new(&mut n, 1..=256).logarithmic(true).text("lights"))
+        .add(
+            egui::Slider::new(&mut n, 1..=256)
+                .logarithmic(true)
+                .text("lights"),
+        )
         .changed()
     {
         *lights = n as usize;
@@ -203,7 +226,11 @@ fn scene_panel(ui: &mut egui::Ui, s: &mut SceneState, gpu_changed: &mut bool) {
     };
     ui.horizontal(|ui| {
         ui.selectable_value(&mut mode, RenderMode::Lights, "lights");
-        ui.selectable_value(&mut mode, RenderMode::Hybrid, "hybrid (lights + SH ambient)");
+        ui.selectable_value(
+            &mut mode,
+            RenderMode::Hybrid,
+            "hybrid (lights + SH ambient)",
+        );
     });
     if mode != RenderMode::Hybrid && d.render.mode == RenderMode::Reference {
         // Untouched: keep the file's reference mode.
@@ -221,20 +248,32 @@ fn scene_panel(ui: &mut egui::Ui, s: &mut SceneState, gpu_changed: &mut bool) {
     d.lighting.lights = n as u32;
     ui.horizontal(|ui| {
         ui.selectable_value(&mut d.lighting.shadows, ShadowKind::Hard, "hard shadows");
-        ui.selectable_value(&mut d.lighting.shadows, ShadowKind::Soft, "soft (light's cone)");
+        ui.selectable_value(
+            &mut d.lighting.shadows,
+            ShadowKind::Soft,
+            "soft (light's cone)",
+        );
     });
     if mode == RenderMode::Hybrid {
         ui.add(egui::Slider::new(&mut d.lighting.ambient_bands, 1..=8).text("ambient SH bands"));
     }
     ui.horizontal(|ui| {
         ui.label("composite");
-        ui.selectable_value(&mut d.render.composite, CompositeRule::Difference, "difference");
+        ui.selectable_value(
+            &mut d.render.composite,
+            CompositeRule::Difference,
+            "difference",
+        );
         ui.selectable_value(&mut d.render.composite, CompositeRule::Ratio, "ratio");
     });
     ui.horizontal(|ui| {
         ui.label("glossy");
         ui.selectable_value(&mut s.glossy, GlossySource::Lights, "lights");
-        ui.selectable_value(&mut s.glossy, GlossySource::Environment, "prefiltered probe");
+        ui.selectable_value(
+            &mut s.glossy,
+            GlossySource::Environment,
+            "prefiltered probe",
+        );
     });
     egui::ComboBox::from_label("shadow maps")
         .selected_text(format!("{0} x {0}", s.shadow_tile))
@@ -245,7 +284,11 @@ fn scene_panel(ui: &mut egui::Ui, s: &mut SceneState, gpu_changed: &mut bool) {
         });
     ui.add(egui::Slider::new(&mut s.background_rays, 1..=4).text("background rays per axis"));
     if let Some(l) = s.lighting() {
-        ui.label(format!("{} ({:.0} ms)", l.summary, s.lighting_seconds * 1e3));
+        ui.label(format!(
+            "{} ({:.0} ms)",
+            l.summary,
+            s.lighting_seconds * 1e3
+        ));
     }
     if s.lighting_busy() {
         ui.label("computing the lights...");
@@ -268,7 +311,8 @@ fn scene_panel(ui: &mut egui::Ui, s: &mut SceneState, gpu_changed: &mut bool) {
     object_panel(ui, s, gpu_changed);
     ui.separator();
     let label = ui.label("Save the edited scene to (Ctrl+S)");
-    ui.text_edit_singleline(&mut s.save_path).labelled_by(label.id);
+    ui.text_edit_singleline(&mut s.save_path)
+        .labelled_by(label.id);
 }
 
 fn object_panel(ui: &mut egui::Ui, s: &mut SceneState, gpu_changed: &mut bool) {
@@ -283,7 +327,9 @@ fn object_panel(ui: &mut egui::Ui, s: &mut SceneState, gpu_changed: &mut bool) {
         }
     });
     let Some(i) = s.selected.filter(|&i| i < count) else {
-        ui.label("click an object to select it; drag to move it, Shift-drag turns, Ctrl-drag scales");
+        ui.label(
+            "click an object to select it; drag to move it, Shift-drag turns, Ctrl-drag scales",
+        );
         return;
     };
     let entry = &mut s.model.description.object[i];
@@ -338,7 +384,11 @@ fn material_controls(ui: &mut egui::Ui, m: &mut MaterialDescription) {
     let before = m.kind;
     ui.horizontal(|ui| {
         ui.label("material");
-        for k in [MaterialKind::Diffuse, MaterialKind::Glossy, MaterialKind::Mirror] {
+        for k in [
+            MaterialKind::Diffuse,
+            MaterialKind::Glossy,
+            MaterialKind::Mirror,
+        ] {
             ui.selectable_value(&mut m.kind, k, name(k));
         }
     });
@@ -373,12 +423,20 @@ fn material_controls(ui: &mut egui::Ui, m: &mut MaterialDescription) {
     }
     if let Some(s) = &mut m.specular {
         ui.horizontal(|ui| {
-            ui.label(if m.kind == MaterialKind::Mirror { "reflectance" } else { "specular" });
+            ui.label(if m.kind == MaterialKind::Mirror {
+                "reflectance"
+            } else {
+                "specular"
+            });
             ui.color_edit_button_rgb(s);
         });
     }
     if let Some(e) = &mut m.exponent {
-        ui.add(egui::Slider::new(e, 1.0..=10000.0).logarithmic(true).text("Phong exponent"));
+        ui.add(
+            egui::Slider::new(e, 1.0..=10000.0)
+                .logarithmic(true)
+                .text("Phong exponent"),
+        );
     }
     if m.kind == MaterialKind::Glossy
         && let (Some(a), Some(s)) = (&mut m.albedo, m.specular)

@@ -7,9 +7,10 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use glam::{Mat3, Vec2, Vec3};
+use ibl_core::tonemap::Display;
 use ibl_core::{Image, LatLong, Rgb};
-use ibl_extract::{LightSource, Method, ModelSpec};
-use ibl_io::Display;
+use ibl_extract::ModelSpec;
+use ibl_light::{LightSource, Method};
 use ibl_mapping::Mapping;
 
 use crate::ViewerError;
@@ -132,7 +133,7 @@ impl ProbeViewSettings {
                 vertical_fov: 75f32.to_radians(),
             },
             display: Display {
-                exposure_stops: ibl_io::tonemap::auto_exposure_stops(probe),
+                exposure_stops: ibl_core::tonemap::auto_exposure_stops(probe),
                 ..Display::default()
             },
             sharpen: 0.0,
@@ -175,10 +176,16 @@ impl ProbeViewSettings {
     }
 
     /// The markers of the overlay in this view; `scale` multiplies sizes (high-DPI screens).
-    pub fn markers(&self, overlay: &ProbeOverlay, width: u32, height: u32, scale: f32) -> Vec<Marker> {
+    pub fn markers(
+        &self,
+        overlay: &ProbeOverlay,
+        width: u32,
+        height: u32,
+        scale: f32,
+    ) -> Vec<Marker> {
         let mut markers = Vec::new();
         if self.overlays.lights {
-            let lum = |l: &ibl_extract::Light| {
+            let lum = |l: &ibl_light::Light| {
                 0.2126 * l.irradiance[0] + 0.7152 * l.irradiance[1] + 0.0722 * l.irradiance[2]
             };
             let brightest = overlay.set.lights.iter().map(lum).fold(0.0f64, f64::max);
@@ -189,7 +196,11 @@ impl ProbeViewSettings {
                     light.direction[2] as f32,
                 );
                 if let Some(p) = self.pixel_of(d, width, height) {
-                    let share = if brightest > 0.0 { (lum(light) / brightest).sqrt() } else { 0.0 };
+                    let share = if brightest > 0.0 {
+                        (lum(light) / brightest).sqrt()
+                    } else {
+                        0.0
+                    };
                     markers.push(Marker {
                         centre: p.to_array(),
                         radius: scale * (4.0 + 12.0 * share as f32),

@@ -93,7 +93,11 @@ pub fn mask_texture(gpu: &GpuContext, mask: Option<&Image<u8>>) -> wgpu::Texture
         usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
         view_formats: &[],
     });
-    let bytes: Vec<u8> = mask.pixels().iter().map(|&m| if m > 0 { 255 } else { 0 }).collect();
+    let bytes: Vec<u8> = mask
+        .pixels()
+        .iter()
+        .map(|&m| if m > 0 { 255 } else { 0 })
+        .collect();
     gpu.queue.write_texture(
         texture.as_image_copy(),
         &bytes,
@@ -204,12 +208,22 @@ impl ProbePass {
         // Minification: probe texels per output pixel, as a mip level.
         let texels_per_pixel = match frame.projection {
             ProbeProjection::LatLong => pw as f32 / w as f32,
-            ProbeProjection::LookAround => (1.0 / c.focal_px.y) / (std::f32::consts::TAU / pw as f32),
+            ProbeProjection::LookAround => {
+                (1.0 / c.focal_px.y) / (std::f32::consts::TAU / pw as f32)
+            }
         };
-        let lod = texels_per_pixel.max(1.0).log2().min(frame.environment.levels as f32 - 1.0);
+        let lod = texels_per_pixel
+            .max(1.0)
+            .log2()
+            .min(frame.environment.levels as f32 - 1.0);
         let uniform = ProbeUniform {
             world_from_camera: mat3_columns(c.world_from_camera),
-            intrinsics: [c.focal_px.x, c.focal_px.y, c.principal_px.x, c.principal_px.y],
+            intrinsics: [
+                c.focal_px.x,
+                c.focal_px.y,
+                c.principal_px.x,
+                c.principal_px.y,
+            ],
             viewport: [w as f32, h as f32, pw as f32, ph as f32],
             probe_from_world: mat3_columns(frame.probe_from_world),
             params: [

@@ -93,14 +93,18 @@ fn object(name: String, vertices: Vec<Vertex>) -> ObjectGeometry {
             ]
         })
         .collect();
-    let (lo, hi) = vertices
-        .iter()
-        .fold((u32::MAX, 0u32), |(lo, hi), v| (lo.min(v.material), hi.max(v.material)));
+    let (lo, hi) = vertices.iter().fold((u32::MAX, 0u32), |(lo, hi), v| {
+        (lo.min(v.material), hi.max(v.material))
+    });
     ObjectGeometry {
         name,
         bounds: bounds_of(&vertices),
         bvh: Bvh::new(&corners),
-        materials: if vertices.is_empty() { 0..0 } else { lo..hi + 1 },
+        materials: if vertices.is_empty() {
+            0..0
+        } else {
+            lo..hi + 1
+        },
         vertices,
     }
 }

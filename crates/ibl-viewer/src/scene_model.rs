@@ -16,7 +16,8 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use glam::{Affine3A, Vec3};
-use ibl_render::lighting::LightingPlan;
+use ibl_light::LightSet;
+use ibl_pipeline::LightingPlan;
 use ibl_scene::description::{
     GeometryDescription, MaterialDescription, MaterialKind, RenderMode, Scale,
 };
@@ -44,6 +45,9 @@ pub struct SceneModel {
     load_placements: Vec<Affine3A>,
     /// Every file the scene read.
     pub inputs: Vec<PathBuf>,
+    /// The lights of the scene's `[lighting] lights_file`, probe frame, with the probe's
+    /// `radiance_scale` applied (the rule of `ibl_pipeline::lighting_plan`); read once at load.
+    given_lights: Option<LightSet>,
 }
 
 /// What the mouse does to the selected object while dragging.
@@ -71,6 +75,13 @@ impl SceneModel {
             source,
         })?;
         let geometry = SceneGeometry::from_scene(&loaded.scene);
+        let given_lights = match &loaded.lights_path {
+            Some(file) => Some(
+                ibl_io::light_file::read_light_set(file)?
+                    .scaled(f64::from(loaded.description.probe.radiance_scale)),
+            ),
+            None => None,
+        };
         let load_placements = loaded
             .description
             .object
@@ -86,6 +97,7 @@ impl SceneModel {
             geometry,
             load_placements,
             inputs: loaded.inputs,
+            given_lights,
         })
     }
 
@@ -222,7 +234,11 @@ impl SceneModel {
     pub fn rotate(&mut self, i: usize, degrees: f32) {
         let entry = &mut self.description.object[i];
         let [yaw, pitch, roll] = entry.rotate_deg.unwrap_or_default();
-        entry.rotate_deg = Some([(yaw + degrees + 180.0).rem_euclid(360.0) - 180.0, pitch, roll]);
+        entry.rotate_deg = Some([
+            (yaw + degrees + 180.0).rem_euclid(360.0) - 180.0,
+            pitch,
+            roll,
+        ]);
     }
 
     /// Scales object `i` by `factor` (> 0) about its origin.
@@ -275,9 +291,9 @@ impl SceneModel {
         let l = &self.description.lighting;
         LightingPlan {
             mode: self.mode(),
-            method: l.method.clone(),
+            source: l.method,
             lights: l.lights as usize,
-            given: None,
+            given: self.given_lights.clone(),
             shadows: l.shadows,
             ambient_bands: l.ambient_bands as usize,
             occlusion_rays: l.ao_samples,

@@ -6,7 +6,7 @@
 //! lights changed or an object moved; then the scene pass and the display transform.
 
 use glam::{Affine3A, Vec3};
-use ibl_io::Display;
+use ibl_core::tonemap::Display;
 use ibl_scene::Background;
 use ibl_scene::description::CompositeRule;
 
@@ -241,7 +241,12 @@ impl SceneRenderer {
             clip_from_world: c.clip_from_world().to_cols_array_2d(),
             world_from_camera: mat3_columns(c.world_from_camera),
             camera_position: vec4(c.position, 1.0),
-            intrinsics: [c.focal_px.x, c.focal_px.y, c.principal_px.x, c.principal_px.y],
+            intrinsics: [
+                c.focal_px.x,
+                c.focal_px.y,
+                c.principal_px.x,
+                c.principal_px.y,
+            ],
             probe_from_world: mat3_columns(probe.world_from_probe.transpose()),
             probe_position: vec4(probe.position, self.environment.scale),
             viewport: [w as f32, h as f32, 1.0 / w as f32, 1.0 / h as f32],
@@ -289,8 +294,11 @@ impl SceneRenderer {
         let started = std::time::Instant::now();
         let count = self.lighting.as_ref().map_or(0, |l| l.lights.len()) as u32;
         // Atlases sized for the lights and the requested tile.
-        let wanted =
-            crate::light_space::AtlasLayout::new(count.max(1), settings.shadow_tile, gpu.max_texture_side());
+        let wanted = crate::light_space::AtlasLayout::new(
+            count.max(1),
+            settings.shadow_tile,
+            gpu.max_texture_side(),
+        );
         if wanted != self.shadows.real.layout {
             self.shadows = ShadowAtlases::new(gpu, count.max(1), settings.shadow_tile);
             self.lights_changed = true;

@@ -106,7 +106,11 @@ pub fn scene_text(
         problem: e.to_string(),
     };
     let (text, original, edited) = if same_folder {
-        (model.text.clone(), model.original.clone(), description.clone())
+        (
+            model.text.clone(),
+            model.original.clone(),
+            description.clone(),
+        )
     } else {
         let original = rebased(&model.original, &from, &to);
         let text = ibl_io::scene_write::edited_scene_text(&model.text, &model.original, &original)
@@ -139,6 +143,9 @@ mod tests {
             std::fs::canonicalize(b.join(&r)).expect("exists"),
             std::fs::canonicalize(a.join("probe.exr")).expect("exists")
         );
-        assert_eq!(rebase(Path::new("/abs/p.exr"), &a, &b), PathBuf::from("/abs/p.exr"));
+        assert_eq!(
+            rebase(Path::new("/abs/p.exr"), &a, &b),
+            PathBuf::from("/abs/p.exr")
+        );
     }
 }

@@ -260,8 +260,7 @@ impl ShadowAtlases {
                     .unwrap_or((0.0, 0.0));
                 toward = toward.max(region.radius);
                 away = away.max(region.radius);
-                let real_map =
-                    ShadowProjection::new(w, region.centre, region.radius, toward, away);
+                let real_map = ShadowProjection::new(w, region.centre, region.radius, toward, away);
                 let index = i as u32;
                 let irradiance = light.irradiance;
                 GpuLight {
@@ -368,7 +367,12 @@ impl ShadowAtlases {
         timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
     ) {
         let bind_group = self.bind_group(gpu, scene);
-        let mut pass = Self::pass(encoder, &self.virtual_objects, "virtual shadows", timestamps);
+        let mut pass = Self::pass(
+            encoder,
+            &self.virtual_objects,
+            "virtual shadows",
+            timestamps,
+        );
         let lights = lights.min(self.capacity());
         if lights == 0 {
             return;
@@ -398,8 +402,14 @@ mod tests {
         };
         assert!(r.holds(Vec3::new(0.5, 0.0, 0.0), 1.0));
         assert!(!r.holds(Vec3::new(1.5, 0.0, 0.0), 1.0));
-        assert!(!r.holds(Vec3::ZERO, 2.0), "scaled up: the tiles would be too coarse");
-        assert!(!r.holds(Vec3::ZERO, 0.3), "scaled down: refit for resolution");
+        assert!(
+            !r.holds(Vec3::ZERO, 2.0),
+            "scaled up: the tiles would be too coarse"
+        );
+        assert!(
+            !r.holds(Vec3::ZERO, 0.3),
+            "scaled down: refit for resolution"
+        );
     }
 
     #[test]

@@ -136,17 +136,23 @@ mod tests {
         for max in [40000.0f32, 1.0e5, 3.3e7] {
             let s = half_scale_for(max);
             assert_eq!(s.log2().fract(), 0.0, "{s} is not a power of two");
-            assert!(max / s <= HALF_HEADROOM && max / s > HALF_HEADROOM / 2.0, "{max} / {s}");
+            assert!(
+                max / s <= HALF_HEADROOM && max / s > HALF_HEADROOM / 2.0,
+                "{max} / {s}"
+            );
         }
     }
 
     #[test]
     fn half_texels_keep_11_bits() {
-        let image = Image::from_vec(2, 1, vec![Rgb::new(0.1, 1.0, 3.0e4), Rgb::splat(7.0)])
-            .expect("2 x 1");
+        let image =
+            Image::from_vec(2, 1, vec![Rgb::new(0.1, 1.0, 3.0e4), Rgb::splat(7.0)]).expect("2 x 1");
         let texels = half_texels(&image, 1.0);
         assert_eq!(texels.len(), 8);
-        for (h, v) in texels.iter().zip([0.1f32, 1.0, 3.0e4, 1.0, 7.0, 7.0, 7.0, 1.0]) {
+        for (h, v) in texels
+            .iter()
+            .zip([0.1f32, 1.0, 3.0e4, 1.0, 7.0, 7.0, 7.0, 1.0])
+        {
             // Half precision: 11 significant bits, a relative rounding error of at most 2^-11.
             assert!((h.to_f32() - v).abs() <= v * 2f32.powi(-11), "{h} vs {v}");
         }

@@ -143,11 +143,12 @@ impl PassTimer {
         self.ran_read = std::mem::replace(&mut self.ran, vec![false; self.names.len()]);
         self.mapped.store(false, Ordering::Release);
         let mapped = Arc::clone(&self.mapped);
-        self.readback.map_async(wgpu::MapMode::Read, .., move |result| {
-            if result.is_ok() {
-                mapped.store(true, Ordering::Release);
-            }
-        });
+        self.readback
+            .map_async(wgpu::MapMode::Read, .., move |result| {
+                if result.is_ok() {
+                    mapped.store(true, Ordering::Release);
+                }
+            });
     }
 
     /// The pass times of the last submitted frame if they are ready; with `wait`, waits for them.

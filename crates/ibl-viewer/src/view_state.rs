@@ -6,7 +6,7 @@ use std::sync::Arc;
 
 use eframe::egui;
 use glam::{Vec2, Vec3};
-use ibl_io::Display;
+use ibl_core::tonemap::Display;
 use ibl_mapping::Mapping;
 use ibl_render::lighting::LightingPlan;
 
@@ -127,7 +127,9 @@ impl Content {
         size: (u32, u32),
         shadow_tile: u32,
     ) -> Result<Content, ViewerError> {
-        let is_scene = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml"));
+        let is_scene = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
         if is_scene {
             let model = SceneModel::open(path)?;
             let renderer = SceneRenderer::new(gpu, &model, size.0, size.1, shadow_tile)?;
@@ -275,7 +277,10 @@ impl Content {
             _ => (w, h),
         };
         let max = crate::frame_targets::MAX_OUTPUT_SIDE as f32;
-        (w.round().clamp(1.0, max) as u32, h.round().clamp(1.0, max) as u32)
+        (
+            w.round().clamp(1.0, max) as u32,
+            h.round().clamp(1.0, max) as u32,
+        )
     }
 
     /// Where a frame of `size` pixels is shown inside `rect`: centred, at its own aspect.
@@ -290,7 +295,12 @@ impl Content {
     }
 
     /// Draws a frame of `size` pixels; `scale` is pixels per point (marker sizes).
-    pub fn draw(&mut self, gpu: &GpuContext, size: (u32, u32), scale: f32) -> Result<(), ViewerError> {
+    pub fn draw(
+        &mut self,
+        gpu: &GpuContext,
+        size: (u32, u32),
+        scale: f32,
+    ) -> Result<(), ViewerError> {
         match self {
             Content::Empty => Ok(()),
             Content::Probe(p) => {
@@ -419,11 +429,14 @@ impl ProbeState {
             let fov = self.settings.orbit.vertical_fov * (-input.scroll * 0.002).exp();
             self.settings.orbit.vertical_fov = fov.clamp(10f32.to_radians(), 150f32.to_radians());
         }
-        self.cursor = response.hover_pos().filter(|p| shown.contains(*p)).map(|p| {
-            let px = frame_pixel(p, shown, size);
-            let d = self.settings.direction_at(px.x, px.y, size.0, size.1);
-            (d, self.model.radiance_towards(d))
-        });
+        self.cursor = response
+            .hover_pos()
+            .filter(|p| shown.contains(*p))
+            .map(|p| {
+                let px = frame_pixel(p, shown, size);
+                let d = self.settings.direction_at(px.x, px.y, size.0, size.1);
+                (d, self.model.radiance_towards(d))
+            });
     }
 }
 
@@ -445,14 +458,18 @@ impl SceneState {
     fn orbit(&mut self) -> &mut OrbitControl {
         if self.camera == SceneCamera::File {
             let c = self.last_camera.unwrap_or_else(|| self.camera((640, 480)));
-            let target = self
-                .model
-                .objects_sphere()
-                .map_or(c.position + c.ray(0.5 * c.size.0 as f32, 0.5 * c.size.1 as f32), |(p, _)| p);
+            let target = self.model.objects_sphere().map_or(
+                c.position + c.ray(0.5 * c.size.0 as f32, 0.5 * c.size.1 as f32),
+                |(p, _)| p,
+            );
             let forward = c.ray(0.5 * c.size.0 as f32, 0.5 * c.size.1 as f32);
             let distance = (target - c.position).dot(forward).max(0.1);
-            self.camera =
-                SceneCamera::Orbit(OrbitControl::from_view(c.position, forward, distance, c.vertical_fov()));
+            self.camera = SceneCamera::Orbit(OrbitControl::from_view(
+                c.position,
+                forward,
+                distance,
+                c.vertical_fov(),
+            ));
         }
         match &mut self.camera {
             SceneCamera::Orbit(o) => o,
@@ -486,7 +503,10 @@ impl SceneState {
             let (o, d) = s.ray_at(&camera, pixel(p));
             s.model.pick(o, d).map(|(i, t)| (i, o + d * t))
         };
-        self.hovered = response.hover_pos().and_then(|p| pick(self, p)).map(|(i, _)| i);
+        self.hovered = response
+            .hover_pos()
+            .and_then(|p| pick(self, p))
+            .map(|(i, _)| i);
         if response.drag_started_by(egui::PointerButton::Primary)
             && let Some(p) = response.interact_pointer_pos()
         {
@@ -512,7 +532,10 @@ impl SceneState {
                 (Some(mut drag), Some(p)) => {
                     if drag.action == DragAction::Move {
                         let ray = self.ray_at(&camera, pixel(p));
-                        let reach = self.model.objects_sphere().map_or(100.0, |(_, r)| 200.0 * r);
+                        let reach = self
+                            .model
+                            .objects_sphere()
+                            .map_or(100.0, |(_, r)| 200.0 * r);
                         self.model
                             .drag_to(drag.object, drag.plane_y, drag.last_ray, ray, reach);
                         drag.last_ray = ray;
@@ -536,7 +559,8 @@ impl SceneState {
         if panning && self.camera_movable() {
             let d = response.drag_delta();
             let orbit = self.orbit();
-            let s = 2.0 * orbit.distance.max(0.1) * (0.5 * orbit.vertical_fov).tan() / shown.height();
+            let s =
+                2.0 * orbit.distance.max(0.1) * (0.5 * orbit.vertical_fov).tan() / shown.height();
             orbit.pan(-d.x * s, d.y * s);
         }
         if response.hovered() && input.scroll != 0.0 && self.camera_movable() {
@@ -549,7 +573,10 @@ impl SceneState {
             }
         }
         if response.clicked() {
-            self.selected = response.interact_pointer_pos().and_then(|p| pick(self, p)).map(|(i, _)| i);
+            self.selected = response
+                .interact_pointer_pos()
+                .and_then(|p| pick(self, p))
+                .map(|(i, _)| i);
         }
     }
 
@@ -594,7 +621,10 @@ impl SceneState {
     }
 
     /// The last frame, read back.
-    pub fn read_frame(&self, gpu: &GpuContext) -> Result<crate::frame_targets::FrameImages, ViewerError> {
+    pub fn read_frame(
+        &self,
+        gpu: &GpuContext,
+    ) -> Result<crate::frame_targets::FrameImages, ViewerError> {
         self.renderer.targets().read_back(gpu)
     }
 

@@ -326,7 +326,10 @@ impl ViewerApp {
                 shot.requested = true;
                 shot.receiver = Some(receiver);
             } else if shot.started.elapsed() > SCREENSHOT_TIMEOUT {
-                self.finish(ctx, Some("the window did not finish its first frames in time".into()));
+                self.finish(
+                    ctx,
+                    Some("the window did not finish its first frames in time".into()),
+                );
             }
             ctx.request_repaint();
             return;

@@ -64,20 +64,38 @@ fn forward_is_centred_right_is_right_and_up_is_up() {
         size: (200, 200),
         ..Default::default()
     };
-    let run = headless::render_probe(&gpu, &model, &settings, &options, &|_, _| {}).expect("renders");
+    let run =
+        headless::render_probe(&gpu, &model, &settings, &options, &|_, _| {}).expect("renders");
     let picture = &run.images.display;
     // f = 100 px for a 90-degree view of 200 px: 30 degrees off-axis is 100 tan(30) = 57.7 px.
-    assert_eq!(dominant(picture.get(100, 100)), Some(0), "forward (-Z) is red at the centre");
-    assert_eq!(dominant(picture.get(158, 100)), Some(1), "30 degrees towards +X is right of centre");
-    assert_eq!(dominant(picture.get(100, 42)), Some(2), "30 degrees towards +Y is above the centre");
-    assert_eq!(dominant(picture.get(42, 100)), None, "nothing is mirrored to the left");
+    assert_eq!(
+        dominant(picture.get(100, 100)),
+        Some(0),
+        "forward (-Z) is red at the centre"
+    );
+    assert_eq!(
+        dominant(picture.get(158, 100)),
+        Some(1),
+        "30 degrees towards +X is right of centre"
+    );
+    assert_eq!(
+        dominant(picture.get(100, 42)),
+        Some(2),
+        "30 degrees towards +Y is above the centre"
+    );
+    assert_eq!(
+        dominant(picture.get(42, 100)),
+        None,
+        "nothing is mirrored to the left"
+    );
 
     settings.projection = ProbeProjection::LatLong;
     let options = HeadlessOptions {
         size: (512, 256),
         ..Default::default()
     };
-    let run = headless::render_probe(&gpu, &model, &settings, &options, &|_, _| {}).expect("renders");
+    let run =
+        headless::render_probe(&gpu, &model, &settings, &options, &|_, _| {}).expect("renders");
     let picture = &run.images.display;
     // CONVENTIONS section 2: forward at (u, v) = (0.5, 0.5); phi = 30 degrees is u = 0.5833.
     assert_eq!(dominant(picture.get(256, 128)), Some(0));

@@ -12,7 +12,10 @@ use ibl_scene::RenderMode;
 use ibl_viewer::view_state::Content;
 use ibl_viewer::window::{ViewerApp, WindowOptions};
 
-fn harness(gpu: &ibl_viewer::GpuContext, input: Option<std::path::PathBuf>) -> Harness<'static, ViewerApp> {
+fn harness(
+    gpu: &ibl_viewer::GpuContext,
+    input: Option<std::path::PathBuf>,
+) -> Harness<'static, ViewerApp> {
     let app = ViewerApp::new(
         gpu.clone(),
         WindowOptions {
@@ -33,7 +36,10 @@ fn harness(gpu: &ibl_viewer::GpuContext, input: Option<std::path::PathBuf>) -> H
 fn step_until(h: &mut Harness<'static, ViewerApp>, done: impl Fn(&ViewerApp) -> bool) {
     let start = Instant::now();
     while !done(h.state()) {
-        assert!(start.elapsed() < Duration::from_secs(60), "the UI never got there");
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "the UI never got there"
+        );
         h.step();
         std::thread::sleep(Duration::from_millis(20));
     }
@@ -75,7 +81,11 @@ fn a_scene_opens_lights_arrive_and_the_panel_edits_it() {
     for p in frame.display.pixels().iter().step_by(37) {
         colours.insert([p[0] / 8, p[1] / 8, p[2] / 8]);
     }
-    assert!(colours.len() > 40, "only {} colours in the frame", colours.len());
+    assert!(
+        colours.len() > 40,
+        "only {} colours in the frame",
+        colours.len()
+    );
 }
 
 #[test]
