@@ -5,7 +5,7 @@
 //! `ibl preview` of the frame's EXR to within one 8-bit code.
 
 use bytemuck::{Pod, Zeroable};
-use ibl_io::{Display, ToneCurve};
+use ibl_core::tonemap::{Display, ToneCurve};
 
 use crate::frame_targets::FrameTargets;
 use crate::gpu::{DISPLAY_FORMAT, GpuContext};

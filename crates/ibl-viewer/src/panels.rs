@@ -162,7 +162,7 @@ fn probe_panel(ui: &mut egui::Ui, p: &mut ProbeState) {
         ui.label(format!(
             "{} lights ({}), {:.0} ms",
             o.set.lights.len(),
-            o.set.method,
+            o.set.provenance.extraction.name(),
             p.overlay_seconds * 1e3
         ));
         if let Some(d) = &o.dominant {
@@ -237,14 +237,12 @@ fn scene_panel(ui: &mut egui::Ui, s: &mut SceneState, gpu_changed: &mut bool) {
     } else {
         d.render.mode = mode;
     }
-    let mut spec: ModelSpec = d
-        .lighting
-        .method
-        .parse()
-        .unwrap_or(ModelSpec::from(Method::MedianCut));
+    let mut spec = ModelSpec::Lights(d.lighting.method);
     let mut n = d.lighting.lights as usize;
     light_source_controls(ui, &mut spec, &mut n);
-    d.lighting.method = spec.to_string();
+    if let ModelSpec::Lights(source) = spec {
+        d.lighting.method = source;
+    }
     d.lighting.lights = n as u32;
     ui.horizontal(|ui| {
         ui.selectable_value(&mut d.lighting.shadows, ShadowKind::Hard, "hard shadows");

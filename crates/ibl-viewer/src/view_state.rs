@@ -8,7 +8,7 @@ use eframe::egui;
 use glam::{Vec2, Vec3};
 use ibl_core::tonemap::Display;
 use ibl_mapping::Mapping;
-use ibl_render::lighting::LightingPlan;
+use ibl_pipeline::LightingPlan;
 
 use crate::ViewerError;
 use crate::frame_targets::FrameTargets;

@@ -64,7 +64,7 @@ fn a_saved_scene_reads_back_as_the_edited_scene() {
         },
     );
     model.description.lighting.lights = 32;
-    model.description.lighting.method = "lightgen".into();
+    model.description.lighting.method = ibl_light::Method::LightGen.into();
     let dir = tempfile::tempdir().expect("temp dir");
     let out = dir.path().join("edited.toml");
     let orbit = OrbitControl::from_view(
