@@ -19,6 +19,9 @@ pub fn is_bad_input(err: &anyhow::Error) -> bool {
             if let Some(e) = cause.downcast_ref::<ibl_pipeline::PipelineError>() {
                 return Some(e.is_bad_input());
             }
+            if let Some(e) = cause.downcast_ref::<ibl_viewer::ViewerError>() {
+                return Some(e.is_bad_input());
+            }
             cause
                 .downcast_ref::<ibl_io::IoError>()
                 .map(ibl_io::IoError::is_bad_input)

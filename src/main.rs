@@ -33,6 +33,7 @@ Examples:
   ibl render assets/scenes/bunny-sky.toml -o bunny.exr   the bunny composited into a probe
   ibl compare render.exr reference.exr       RMSE, relative MSE and FLIP of a render
   ibl capture merge IMG_*.jpg -o probe.exr   bracketed exposures to HDR
+  ibl view assets/scenes/bunny-sky.toml      real-time viewer: 16 shadowed lights, edit, save
 
 Exit codes: 0 success, 1 internal failure, 2 bad input or arguments.";
 
@@ -60,6 +61,8 @@ enum Command {
     Preview(cmd::preview::PreviewArgs),
     /// Run the main job on the bundled probes and write everything to a folder.
     Demo(cmd::demo::DemoArgs),
+    /// Real-time viewer: a probe, or a scene composited with a shadow per light (or --headless).
+    View(cmd::view::ViewArgs),
 }
 
 fn main() -> ExitCode {
@@ -87,6 +90,7 @@ fn main() -> ExitCode {
         Command::Capture(args) => cmd::capture::run(&args),
         Command::Preview(args) => cmd::preview::run(&args),
         Command::Demo(args) => cmd::demo::run(&args),
+        Command::View(args) => cmd::view::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -11,3 +11,4 @@ pub mod lights;
 pub mod preview;
 pub mod render;
 pub mod sh;
+pub mod view;

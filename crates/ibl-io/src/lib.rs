@@ -29,6 +29,7 @@ pub mod pfm;
 pub mod photo;
 pub mod sanitize;
 pub mod scene_file;
+pub mod scene_write;
 pub mod sh_file;
 
 use std::io::Write;

@@ -292,6 +292,20 @@ impl Bvh {
         self.indices.len()
     }
 
+    /// The corners of every triangle, in input order (`Hit::triangle` indexes this list): what a
+    /// rasteriser draws of the same geometry (the real-time viewer).
+    pub fn triangles(&self) -> Vec<[Vec3; 3]> {
+        let mut corners = vec![[Vec3::ZERO; 3]; self.indices.len()];
+        for (&index, t) in self.indices.iter().zip(&self.triangles) {
+            corners[index as usize] = [
+                Vec3::new(t[0], t[1], t[2]),
+                Vec3::new(t[3], t[4], t[5]),
+                Vec3::new(t[6], t[7], t[8]),
+            ];
+        }
+        corners
+    }
+
     /// Number of nodes, inner and leaves (0 when empty, 1 for a single leaf).
     pub fn node_count(&self) -> usize {
         if self.indices.is_empty() {
@@ -811,6 +825,13 @@ mod tests {
         assert_eq!(one.indices, many.indices);
         assert_eq!(one.triangles, many.triangles);
         assert_eq!(one.depth, many.depth);
+    }
+
+    #[test]
+    fn triangles_come_back_in_input_order() {
+        let tris = soup(500, 3);
+        assert_eq!(Bvh::new(&tris).triangles(), tris);
+        assert!(Bvh::new(&[]).triangles().is_empty());
     }
 
     #[test]

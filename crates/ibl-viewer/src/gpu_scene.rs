@@ -1,0 +1,278 @@
+//! The scene's data on the GPU: vertex buffers, materials, object transforms, lights and the
+//! per-frame uniform. The structs here are the byte-for-byte twins of `gpu_scene.wgsl` (every
+//! field a 16-byte column, so neither side pads).
+
+use bytemuck::{Pod, Zeroable};
+use glam::{Affine3A, Mat3, Mat4, Vec4};
+use ibl_scene::Material;
+use wgpu::util::DeviceExt;
+
+use crate::gpu::GpuContext;
+use crate::scene_geometry::SceneGeometry;
+
+/// `Frame` of `gpu_scene.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct FrameUniform {
+    /// Clip space from world.
+    pub clip_from_world: [[f32; 4]; 4],
+    /// Camera right, up, back (columns).
+    pub world_from_camera: [[f32; 4]; 4],
+    /// The eye.
+    pub camera_position: [f32; 4],
+    /// fx, fy, cx, cy (output pixels).
+    pub intrinsics: [f32; 4],
+    /// World to probe frame.
+    pub probe_from_world: [[f32; 4]; 4],
+    /// Probe centre and the probe texture's radiance scale.
+    pub probe_position: [f32; 4],
+    /// width, height, 1 / width, 1 / height.
+    pub viewport: [f32; 4],
+    /// lights, composite rule, shadows, background kind.
+    pub counts: [u32; 4],
+    /// glossy source, ambient present, background rays per axis, frame number.
+    pub options: [u32; 4],
+    /// glossy level-1 exponent, glossy levels, photo scale, ambient scale.
+    pub environment: [f32; 4],
+    /// real atlas size, virtual atlas size (texels).
+    pub atlas: [f32; 4],
+}
+
+/// `Light` of `gpu_scene.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuLight {
+    /// Direction towards the light; w: tan of the cone's half-angle.
+    pub direction: [f32; 4],
+    /// `I = L A`.
+    pub irradiance: [f32; 4],
+    /// Real atlas projection.
+    pub real_map: [[f32; 4]; 4],
+    /// Real atlas tile (uv rect).
+    pub real_tile: [f32; 4],
+    /// Real tile half extent, depth range, texel size (world units).
+    pub real_extent: [f32; 4],
+    /// Virtual atlas projection.
+    pub virtual_map: [[f32; 4]; 4],
+    /// Virtual atlas tile.
+    pub virtual_tile: [f32; 4],
+    /// Virtual tile extents.
+    pub virtual_extent: [f32; 4],
+}
+
+/// `Object` of `gpu_scene.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuObject {
+    /// World from the load frame.
+    pub world_from_load: [[f32; 4]; 4],
+    /// Its normal matrix.
+    pub normal_from_load: [[f32; 4]; 4],
+    /// layer (0 real, 1 virtual), selected, 0, 0.
+    pub flags: [u32; 4],
+}
+
+/// `Material` of `gpu_scene.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuMaterial {
+    /// Diffuse albedo and kind (0 diffuse, 1 glossy, 2 mirror).
+    pub albedo_kind: [f32; 4],
+    /// Specular or mirror reflectance and Phong exponent.
+    pub specular_exponent: [f32; 4],
+}
+
+impl GpuMaterial {
+    /// The GPU form of a material.
+    pub fn of(material: &Material) -> GpuMaterial {
+        match *material {
+            Material::Diffuse { albedo } => GpuMaterial {
+                albedo_kind: [albedo.r, albedo.g, albedo.b, 0.0],
+                specular_exponent: [0.0; 4],
+            },
+            Material::Glossy {
+                albedo,
+                specular,
+                exponent,
+            } => GpuMaterial {
+                albedo_kind: [albedo.r, albedo.g, albedo.b, 1.0],
+                specular_exponent: [specular.r, specular.g, specular.b, exponent],
+            },
+            Material::Mirror { reflectance } => GpuMaterial {
+                albedo_kind: [0.0, 0.0, 0.0, 2.0],
+                specular_exponent: [reflectance.r, reflectance.g, reflectance.b, 0.0],
+            },
+        }
+    }
+}
+
+impl GpuObject {
+    /// An object drawn through `world_from_load`.
+    pub fn new(world_from_load: Affine3A, is_virtual: bool, selected: bool) -> GpuObject {
+        let m = Mat4::from(world_from_load);
+        let normal = Mat3::from(world_from_load.matrix3).inverse().transpose();
+        GpuObject {
+            world_from_load: m.to_cols_array_2d(),
+            normal_from_load: Mat4::from_mat3(normal).to_cols_array_2d(),
+            flags: [u32::from(is_virtual), u32::from(selected), 0, 0],
+        }
+    }
+}
+
+/// A column-major 4 x 4 from a 3 x 3 rotation.
+pub fn mat3_columns(m: Mat3) -> [[f32; 4]; 4] {
+    Mat4::from_mat3(m).to_cols_array_2d()
+}
+
+/// A vector with a fourth component.
+pub fn vec4(v: glam::Vec3, w: f32) -> [f32; 4] {
+    Vec4::new(v.x, v.y, v.z, w).to_array()
+}
+
+/// One vertex buffer.
+#[derive(Debug)]
+pub struct MeshBuffer {
+    /// The vertices (three per triangle).
+    pub buffer: wgpu::Buffer,
+    /// How many vertices.
+    pub vertices: u32,
+}
+
+/// Buffers of a scene.
+#[derive(Debug)]
+pub struct GpuScene {
+    /// Real geometry (object 0).
+    pub real: MeshBuffer,
+    /// Virtual objects (objects 1..).
+    pub objects: Vec<MeshBuffer>,
+    /// Materials (storage).
+    pub materials: wgpu::Buffer,
+    /// Object transforms (storage), real first.
+    pub transforms: wgpu::Buffer,
+    /// Lights (storage), at least one entry.
+    pub lights: wgpu::Buffer,
+    /// How many lights `lights` holds room for.
+    pub light_capacity: usize,
+    /// The frame uniform.
+    pub frame: wgpu::Buffer,
+}
+
+fn mesh(gpu: &GpuContext, label: &str, vertices: &[crate::scene_geometry::Vertex]) -> MeshBuffer {
+    // wgpu refuses empty buffers: one degenerate vertex stands in (never drawn).
+    let dummy = [crate::scene_geometry::Vertex::zeroed()];
+    let data: &[crate::scene_geometry::Vertex] = if vertices.is_empty() {
+        &dummy
+    } else {
+        vertices
+    };
+    MeshBuffer {
+        buffer: gpu
+            .device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents: bytemuck::cast_slice(data),
+                usage: wgpu::BufferUsages::VERTEX,
+            }),
+        vertices: vertices.len() as u32,
+    }
+}
+
+fn storage(gpu: &GpuContext, label: &str, bytes: &[u8]) -> wgpu::Buffer {
+    gpu.device
+        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(label),
+            contents: bytes,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        })
+}
+
+impl GpuScene {
+    /// Uploads the geometry and materials; transforms at load, no lights yet.
+    pub fn new(gpu: &GpuContext, geometry: &SceneGeometry) -> GpuScene {
+        let materials: Vec<GpuMaterial> = geometry.materials.iter().map(GpuMaterial::of).collect();
+        let materials = if materials.is_empty() {
+            vec![GpuMaterial::zeroed()]
+        } else {
+            materials
+        };
+        let mut transforms = vec![GpuObject::new(Affine3A::IDENTITY, false, false)];
+        transforms.extend(
+            geometry
+                .objects
+                .iter()
+                .map(|_| GpuObject::new(Affine3A::IDENTITY, true, false)),
+        );
+        GpuScene {
+            real: mesh(gpu, "real geometry", &geometry.real.vertices),
+            objects: geometry
+                .objects
+                .iter()
+                .map(|o| mesh(gpu, &o.name, &o.vertices))
+                .collect(),
+            materials: storage(gpu, "materials", bytemuck::cast_slice(&materials)),
+            transforms: storage(gpu, "objects", bytemuck::cast_slice(&transforms)),
+            lights: storage(gpu, "lights", bytemuck::bytes_of(&GpuLight::zeroed())),
+            light_capacity: 1,
+            frame: gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("frame"),
+                size: std::mem::size_of::<FrameUniform>() as u64,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+        }
+    }
+
+    /// Writes the lights, growing the buffer when needed; true when it was replaced (bind
+    /// groups must then be rebuilt).
+    pub fn write_lights(&mut self, gpu: &GpuContext, lights: &[GpuLight]) -> bool {
+        let data: Vec<GpuLight> = if lights.is_empty() {
+            vec![GpuLight::zeroed()]
+        } else {
+            lights.to_vec()
+        };
+        if data.len() > self.light_capacity {
+            self.lights = storage(gpu, "lights", bytemuck::cast_slice(&data));
+            self.light_capacity = data.len();
+            return true;
+        }
+        gpu.queue
+            .write_buffer(&self.lights, 0, bytemuck::cast_slice(&data));
+        false
+    }
+
+    /// Writes the object transforms (real first).
+    pub fn write_transforms(&self, gpu: &GpuContext, objects: &[GpuObject]) {
+        gpu.queue
+            .write_buffer(&self.transforms, 0, bytemuck::cast_slice(objects));
+    }
+
+    /// Writes the materials.
+    pub fn write_materials(&self, gpu: &GpuContext, materials: &[Material]) {
+        let data: Vec<GpuMaterial> = materials.iter().map(GpuMaterial::of).collect();
+        if !data.is_empty() {
+            gpu.queue
+                .write_buffer(&self.materials, 0, bytemuck::cast_slice(&data));
+        }
+    }
+
+    /// Writes the frame uniform.
+    pub fn write_frame(&self, gpu: &GpuContext, frame: &FrameUniform) {
+        gpu.queue
+            .write_buffer(&self.frame, 0, bytemuck::bytes_of(frame));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn structs_match_their_wgsl_sizes() {
+        // Sums of the WGSL members (all 16-byte columns): no padding on either side.
+        assert_eq!(std::mem::size_of::<FrameUniform>(), 3 * 64 + 8 * 16);
+        assert_eq!(std::mem::size_of::<GpuLight>(), 2 * 64 + 6 * 16);
+        assert_eq!(std::mem::size_of::<GpuObject>(), 2 * 64 + 16);
+        assert_eq!(std::mem::size_of::<GpuMaterial>(), 32);
+        assert_eq!(std::mem::size_of::<crate::scene_geometry::Vertex>(), 28);
+    }
+}

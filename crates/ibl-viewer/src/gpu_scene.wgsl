@@ -1,0 +1,67 @@
+// The scene's GPU data (gpu_scene.rs holds the Rust twins; keep both in step): every struct is
+// made of 16-byte columns so that the WGSL and Rust layouts agree without padding rules.
+
+struct Frame {
+    // Clip space from world (reversed depth, far plane at infinity: view_camera.rs).
+    clip_from_world: mat4x4<f32>,
+    // Columns: camera right, up, back in world coordinates.
+    world_from_camera: mat4x4<f32>,
+    // xyz: the eye.
+    camera_position: vec4<f32>,
+    // fx, fy, cx, cy in output pixels.
+    intrinsics: vec4<f32>,
+    // Rotation from world to the probe frame (columns).
+    probe_from_world: mat4x4<f32>,
+    // xyz: the probe's centre; w: radiance = probe texel x w.
+    probe_position: vec4<f32>,
+    // width, height, 1 / width, 1 / height.
+    viewport: vec4<f32>,
+    // light count, composite rule (0 difference, 1 ratio), shadows (0 hard, 1 soft),
+    // background (0 panorama, 1 photo).
+    counts: vec4<u32>,
+    // glossy source (0 the lights, 1 the prefiltered probe), ambient (0 none, 1 the SH map),
+    // background rays per pixel axis, frame number.
+    options: vec4<u32>,
+    // glossy chain: exponent of level 1, levels; photo scale; ambient scale.
+    environment: vec4<f32>,
+    // real atlas width, height; virtual atlas width, height (texels).
+    atlas: vec4<f32>,
+};
+
+struct Light {
+    // xyz: unit direction towards the light; w: tan of the half-angle of its cone.
+    direction: vec4<f32>,
+    // rgb: I = L A, the irradiance on a surface facing the light.
+    irradiance: vec4<f32>,
+    // World to (x, y, depth) of this light's tile in the real-geometry atlas.
+    real_map: mat4x4<f32>,
+    // The tile in atlas texture coordinates: u0, v0, du, dv.
+    real_tile: vec4<f32>,
+    // half extent and depth range of the tile (world units), world size of a texel, 0.
+    real_extent: vec4<f32>,
+    virtual_map: mat4x4<f32>,
+    virtual_tile: vec4<f32>,
+    virtual_extent: vec4<f32>,
+};
+
+struct Object {
+    // World from the frame the vertices were loaded in (identity for real geometry).
+    world_from_load: mat4x4<f32>,
+    // Inverse transpose of its upper 3 x 3 (normals).
+    normal_from_load: mat4x4<f32>,
+    // layer (0 real, 1 virtual), selected (0 or 1), 0, 0.
+    flags: vec4<u32>,
+};
+
+struct Material {
+    // rgb: diffuse albedo; w: kind (0 diffuse, 1 glossy, 2 mirror).
+    albedo_kind: vec4<f32>,
+    // rgb: specular (glossy) or mirror reflectance; w: Phong exponent.
+    specular_exponent: vec4<f32>,
+};
+
+struct Vertex {
+    @location(0) position: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) material: u32,
+};

@@ -1,0 +1,135 @@
+//! The scene's triangles as the rasteriser draws them, taken from the assembled
+//! `ibl_scene::Scene` (so the viewer draws exactly the geometry, normals and materials the CPU
+//! renderer traces, placed by the same code): real geometry merged into one vertex list, every
+//! virtual object a list of its own so that it can move. Positions and normals are in the world
+//! frame of the loaded scene; a moved object is drawn through `world_from_load`, its transform
+//! relative to where the file put it.
+//!
+//! Each object keeps a BVH of its triangles (in the load frame) for picking with the mouse.
+
+use std::ops::Range;
+
+use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
+use ibl_scene::{Bvh, GeometryLayer, Material, Scene};
+
+/// One vertex: world position and unit normal at load, and a global material index.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct Vertex {
+    /// Position, load frame.
+    pub position: [f32; 3],
+    /// Unit normal (the vertex normal of a smooth mesh, the face normal of a flat one).
+    pub normal: [f32; 3],
+    /// Index into [`SceneGeometry::materials`].
+    pub material: u32,
+}
+
+/// The vertex layout of [`Vertex`] for pipelines.
+pub const VERTEX_ATTRIBUTES: [wgpu::VertexAttribute; 3] =
+    wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Uint32];
+
+/// Triangles of one object (three vertices each).
+#[derive(Clone, Debug)]
+pub struct ObjectGeometry {
+    /// Name from the scene file.
+    pub name: String,
+    /// Three vertices per triangle.
+    pub vertices: Vec<Vertex>,
+    /// The triangles for picking (load frame).
+    pub bvh: Bvh,
+    /// Axis-aligned bounds at load, `(min, max)`.
+    pub bounds: (Vec3, Vec3),
+    /// Global material indices this object uses.
+    pub materials: Range<u32>,
+}
+
+/// Everything the viewer draws.
+#[derive(Clone, Debug)]
+pub struct SceneGeometry {
+    /// The real (local) geometry, merged.
+    pub real: ObjectGeometry,
+    /// The virtual objects, in file order.
+    pub objects: Vec<ObjectGeometry>,
+    /// Real materials, then every virtual object's.
+    pub materials: Vec<Material>,
+}
+
+fn bounds_of(vertices: &[Vertex]) -> (Vec3, Vec3) {
+    vertices.iter().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(lo, hi), v| {
+            let p = Vec3::from(v.position);
+            (lo.min(p), hi.max(p))
+        },
+    )
+}
+
+/// Per object of `layer`: its vertices (materials offset by `material_base`).
+fn layer_objects(layer: &GeometryLayer, material_base: u32) -> Vec<Vec<Vertex>> {
+    let corners = layer.bvh.triangles();
+    let mut objects = vec![Vec::new(); layer.object_names.len()];
+    for (tri, surface) in corners.iter().zip(&layer.surfaces) {
+        let out: &mut Vec<Vertex> = &mut objects[surface.object as usize];
+        for k in 0..3 {
+            out.push(Vertex {
+                position: tri[k].to_array(),
+                normal: surface.normals[k].to_array(),
+                material: material_base + surface.material,
+            });
+        }
+    }
+    objects
+}
+
+fn object(name: String, vertices: Vec<Vertex>) -> ObjectGeometry {
+    let corners: Vec<[Vec3; 3]> = vertices
+        .chunks_exact(3)
+        .map(|t| {
+            [
+                Vec3::from(t[0].position),
+                Vec3::from(t[1].position),
+                Vec3::from(t[2].position),
+            ]
+        })
+        .collect();
+    let (lo, hi) = vertices.iter().fold((u32::MAX, 0u32), |(lo, hi), v| {
+        (lo.min(v.material), hi.max(v.material))
+    });
+    ObjectGeometry {
+        name,
+        bounds: bounds_of(&vertices),
+        bvh: Bvh::new(&corners),
+        materials: if vertices.is_empty() {
+            0..0
+        } else {
+            lo..hi + 1
+        },
+        vertices,
+    }
+}
+
+impl SceneGeometry {
+    /// The geometry of a loaded scene. O(T log T) for T triangles (the picking BVHs).
+    pub fn from_scene(scene: &Scene) -> SceneGeometry {
+        let real_count = scene.real.materials.len() as u32;
+        let real: Vec<Vertex> = layer_objects(&scene.real, 0).concat();
+        let objects = layer_objects(&scene.virtual_objects, real_count)
+            .into_iter()
+            .zip(&scene.virtual_objects.object_names)
+            .map(|(vertices, name)| object(name.clone(), vertices))
+            .collect();
+        let mut materials = scene.real.materials.clone();
+        materials.extend(&scene.virtual_objects.materials);
+        SceneGeometry {
+            real: object("real geometry".into(), real),
+            objects,
+            materials,
+        }
+    }
+
+    /// Bounds of the real geometry at load; `None` when there is none.
+    pub fn real_bounds(&self) -> Option<(Vec3, Vec3)> {
+        (!self.real.vertices.is_empty()).then_some(self.real.bounds)
+    }
+}

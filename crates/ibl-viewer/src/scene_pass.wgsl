@@ -1,0 +1,329 @@
+// The scene pass (scene_pass.rs); prepended by gpu_scene.wgsl and shadow_lookup.wgsl.
+//
+// Geometry first, then the sky: a full-screen triangle at the far plane that the depth test
+// keeps only where no geometry was drawn. Every fragment writes the final composite of
+// differential rendering (Debevec 1998; Grosch 2005 section 4.1), the same per-sample rule as
+// ibl-render's `render`:
+//
+// - virtual object: its own radiance, lit by the lights (each with its shadow from the real and
+//   the virtual atlas), the hybrid ambient, mirrors and optionally glossy lobes reflecting the
+//   probe;
+// - real surface: the background B at that point plus the change the objects make,
+//   `B + (with - without)` (difference) or `B with / without` (ratio, falling back to the
+//   difference where `without` is 0), where with and without light the real surface's albedo
+//   with and without the virtual casters;
+// - sky: the background B.
+//
+// B along a pixel is, as in ibl-render's `background`, the mean of an n x n grid of sub-pixel
+// rays each reading its nearest probe texel (panorama), or the photo's pixel (photo). On real
+// surfaces the rays run from the probe's centre to the surface (Grosch 2005 section 4.4: the
+// probe projected on the geometry), which equals the camera's rays when the camera is at the
+// probe's centre. Coverage (location 1) is 1 on virtual objects: resolved, it is the object's
+// alpha, the CPU renderer's `object_coverage`.
+
+@group(0) @binding(0) var<uniform> frame: Frame;
+@group(0) @binding(1) var<storage, read> lights: array<Light>;
+@group(0) @binding(2) var<storage, read> objects: array<Object>;
+@group(0) @binding(3) var<storage, read> materials: array<Material>;
+@group(0) @binding(4) var probe: texture_2d<f32>;
+@group(0) @binding(5) var glossy: texture_2d<f32>;
+@group(0) @binding(6) var probe_sampler: sampler;
+@group(0) @binding(7) var ambient: texture_2d<f32>;
+@group(0) @binding(8) var photo: texture_2d<f32>;
+@group(0) @binding(9) var real_atlas: texture_depth_2d;
+@group(0) @binding(10) var virtual_atlas: texture_depth_2d;
+@group(0) @binding(11) var shadow_sampler: sampler_comparison;
+
+const PI: f32 = 3.14159265358979;
+
+struct GeometryOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) world: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) @interpolate(flat) material: u32,
+    @location(3) @interpolate(flat) object: u32,
+};
+
+struct FragmentOut {
+    @location(0) radiance: vec4<f32>,
+    @location(1) coverage: vec4<f32>,
+};
+
+@vertex
+fn vs_geometry(vertex: Vertex, @builtin(instance_index) object: u32) -> GeometryOut {
+    let o = objects[object];
+    let world = o.world_from_load * vec4<f32>(vertex.position, 1.0);
+    var out: GeometryOut;
+    out.clip = frame.clip_from_world * world;
+    out.world = world.xyz;
+    out.normal = (o.normal_from_load * vec4<f32>(vertex.normal, 0.0)).xyz;
+    out.material = vertex.material;
+    out.object = object;
+    return out;
+}
+
+// CONVENTIONS section 2, as ibl_core::LatLong::dir_to_pixel: the texel holding direction d
+// (probe frame); the column wraps, the row clamps.
+fn probe_texel(d: vec3<f32>, size: vec2<u32>) -> vec2<i32> {
+    let theta = atan2(length(d.xz), d.y);
+    var u = atan2(d.x, -d.z) / (2.0 * PI) + 0.5;
+    u = u - floor(u);
+    let v = theta / PI;
+    let i = min(u32(u * f32(size.x)), size.x - 1u);
+    let j = min(u32(max(v, 0.0) * f32(size.y)), size.y - 1u);
+    return vec2<i32>(i32(i), i32(j));
+}
+
+fn dir_to_uv(d: vec3<f32>) -> vec2<f32> {
+    let theta = atan2(length(d.xz), d.y);
+    return vec2<f32>(atan2(d.x, -d.z) / (2.0 * PI) + 0.5, theta / PI);
+}
+
+// Nearest probe texel along world direction d.
+fn probe_nearest(d: vec3<f32>) -> vec3<f32> {
+    let size = textureDimensions(probe, 0);
+    let local = (frame.probe_from_world * vec4<f32>(d, 0.0)).xyz;
+    return textureLoad(probe, probe_texel(local, size), 0).rgb * frame.probe_position.w;
+}
+
+// Filtered probe radiance along world direction d at a mip level of a chain.
+fn probe_filtered(chain: texture_2d<f32>, d: vec3<f32>, level: f32) -> vec3<f32> {
+    let local = (frame.probe_from_world * vec4<f32>(d, 0.0)).xyz;
+    return textureSampleLevel(chain, probe_sampler, dir_to_uv(local), level).rgb * frame.probe_position.w;
+}
+
+// The camera ray through continuous pixel coordinates (view_camera.rs).
+fn camera_ray(px: vec2<f32>) -> vec3<f32> {
+    let k = frame.intrinsics;
+    let d = vec3<f32>((px.x - k.z) / k.x, -(px.y - k.w) / k.y, -1.0);
+    return normalize((frame.world_from_camera * vec4<f32>(d, 0.0)).xyz);
+}
+
+fn photo_pixel(pixel: vec2<f32>) -> vec3<f32> {
+    return textureLoad(photo, vec2<i32>(pixel), 0).rgb * frame.environment.z;
+}
+
+// B seen through the pixel at `pixel` (its top-left corner is floor(pixel)) along camera rays.
+fn background_sky(pixel: vec2<f32>) -> vec3<f32> {
+    if frame.counts.w == 1u {
+        return photo_pixel(pixel);
+    }
+    let n = max(frame.options.z, 1u);
+    let corner = floor(pixel);
+    var sum = vec3<f32>(0.0);
+    for (var sy = 0u; sy < n; sy = sy + 1u) {
+        for (var sx = 0u; sx < n; sx = sx + 1u) {
+            let at = corner + (vec2<f32>(f32(sx), f32(sy)) + 0.5) / f32(n);
+            sum = sum + probe_nearest(camera_ray(at));
+        }
+    }
+    return sum / f32(n * n);
+}
+
+// B on a real surface point p, with its screen derivatives, seen from the probe's centre.
+fn background_surface(pixel: vec2<f32>, p: vec3<f32>, dx: vec3<f32>, dy: vec3<f32>) -> vec3<f32> {
+    if frame.counts.w == 1u {
+        return photo_pixel(pixel);
+    }
+    let n = max(frame.options.z, 1u);
+    // The fragment is shaded at the pixel centre; sub-pixel offsets from there.
+    let centre = pixel - floor(pixel);
+    var sum = vec3<f32>(0.0);
+    for (var sy = 0u; sy < n; sy = sy + 1u) {
+        for (var sx = 0u; sx < n; sx = sx + 1u) {
+            let o = (vec2<f32>(f32(sx), f32(sy)) + 0.5) / f32(n) - centre;
+            let q = p + dx * o.x + dy * o.y;
+            sum = sum + probe_nearest(normalize(q - frame.probe_position.xyz));
+        }
+    }
+    return sum / f32(n * n);
+}
+
+// f(wo, wi) cos(theta_i) of a material (ibl-render's Bsdf::eval times the cosine): zero unless
+// wo and wi are above the geometric surface and wi above the shading surface.
+fn reflection(m: Material, ns: vec3<f32>, ng: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>, with_lobe: bool) -> vec3<f32> {
+    let cos_i = dot(wi, ns);
+    if dot(wo, ng) <= 0.0 || dot(wi, ng) <= 0.0 || cos_i <= 0.0 {
+        return vec3<f32>(0.0);
+    }
+    let kind = u32(m.albedo_kind.w);
+    if kind == 2u {
+        return vec3<f32>(0.0);
+    }
+    var f = m.albedo_kind.rgb / PI;
+    if kind == 1u && with_lobe {
+        let r = 2.0 * dot(wo, ns) * ns - wo;
+        let cos_a = dot(wi, r);
+        if cos_a > 0.0 {
+            let e = m.specular_exponent.w;
+            f = f + m.specular_exponent.rgb * ((e + 2.0) / (2.0 * PI) * pow(cos_a, e));
+        }
+    }
+    return f * cos_i;
+}
+
+// E(n) of the hybrid ambient (world-frame lat-long map).
+fn ambient_irradiance(n: vec3<f32>) -> vec3<f32> {
+    if frame.options.y == 0u {
+        return vec3<f32>(0.0);
+    }
+    return textureSampleLevel(ambient, probe_sampler, dir_to_uv(n), 0.0).rgb * frame.environment.w;
+}
+
+fn noise(pixel: vec2<f32>) -> f32 {
+    // Interleaved gradient noise (Jimenez 2014): decorrelates the PCSS rotations of neighbours.
+    return fract(52.9829189 * fract(dot(pixel, vec2<f32>(0.06711056, 0.00583715))));
+}
+
+// Shading normal and camera-facing geometric normal, as ibl_scene's `surface_point`: both
+// flipped to face the viewer (two-sided), the shading normal bent back to the geometric side.
+struct SurfaceFrame {
+    ns: vec3<f32>,
+    ng: vec3<f32>,
+};
+
+fn facing(in_normal: vec3<f32>, dx: vec3<f32>, dy: vec3<f32>, wo: vec3<f32>, front: bool) -> SurfaceFrame {
+    var ng = normalize(cross(dx, dy));
+    if dot(ng, wo) < 0.0 {
+        ng = -ng;
+    }
+    var ns = ng;
+    if dot(in_normal, in_normal) > 1e-20 {
+        ns = normalize(in_normal);
+        if !front {
+            ns = -ns;
+        }
+    }
+    if dot(ns, ng) <= 0.0 {
+        ns = ng;
+    }
+    var out: SurfaceFrame;
+    out.ns = ns;
+    out.ng = ng;
+    return out;
+}
+
+fn shade_virtual(m: Material, p: vec3<f32>, f: SurfaceFrame, wo: vec3<f32>, pixel_noise: f32) -> vec3<f32> {
+    let kind = u32(m.albedo_kind.w);
+    let ns = f.ns;
+    if kind == 2u {
+        // A perfect mirror reflects the probe (level 0 of the chain).
+        let r = 2.0 * dot(wo, ns) * ns - wo;
+        return m.specular_exponent.rgb * probe_filtered(probe, r, 0.0);
+    }
+    let lobe_from_lights = frame.options.x == 0u;
+    var radiance = vec3<f32>(0.0);
+    let count = frame.counts.x;
+    for (var i = 0u; i < count; i = i + 1u) {
+        let wi = lights[i].direction.xyz;
+        let fc = reflection(m, ns, f.ng, wo, wi, lobe_from_lights);
+        if all(fc <= vec3<f32>(0.0)) {
+            continue;
+        }
+        let v = real_visibility(i, p, f.ng, pixel_noise) * virtual_visibility(i, p, f.ng, pixel_noise);
+        radiance = radiance + fc * lights[i].irradiance.rgb * v;
+    }
+    radiance = radiance + m.albedo_kind.rgb / PI * ambient_irradiance(ns);
+    if kind == 1u && !lobe_from_lights {
+        // The glossy lobe reflecting the prefiltered probe (environment_maps.rs).
+        let r = 2.0 * dot(wo, ns) * ns - wo;
+        let e = m.specular_exponent.w;
+        let level = clamp(1.0 + 0.5 * log2(frame.environment.x / max(e, 1e-6)), 0.0,
+                          frame.environment.y - 1.0);
+        radiance = radiance + m.specular_exponent.rgb * probe_filtered(glossy, r, level);
+    }
+    return radiance;
+}
+
+// The composite on a real surface (module notes).
+fn composite_real(m: Material, p: vec3<f32>, f: SurfaceFrame, wo: vec3<f32>, b: vec3<f32>, pixel_noise: f32) -> vec3<f32> {
+    let count = frame.counts.x;
+    // with - without: only lights the virtual objects block change anything.
+    var change = vec3<f32>(0.0);
+    var affected = false;
+    for (var i = 0u; i < count; i = i + 1u) {
+        let wi = lights[i].direction.xyz;
+        let fc = reflection(m, f.ns, f.ng, wo, wi, true);
+        if all(fc <= vec3<f32>(0.0)) {
+            continue;
+        }
+        let vv = virtual_visibility(i, p, f.ng, pixel_noise);
+        if vv < 1.0 {
+            affected = true;
+            let vr = real_visibility(i, p, f.ng, pixel_noise);
+            change = change + fc * lights[i].irradiance.rgb * (vr * (vv - 1.0));
+        }
+    }
+    if !affected {
+        return b;
+    }
+    if frame.counts.y == 0u {
+        return max(b + change, vec3<f32>(0.0));
+    }
+    var without = m.albedo_kind.rgb / PI * ambient_irradiance(f.ns);
+    for (var i = 0u; i < count; i = i + 1u) {
+        let wi = lights[i].direction.xyz;
+        let fc = reflection(m, f.ns, f.ng, wo, wi, true);
+        if all(fc <= vec3<f32>(0.0)) {
+            continue;
+        }
+        without = without + fc * lights[i].irradiance.rgb * real_visibility(i, p, f.ng, pixel_noise);
+    }
+    let lit = without + change;
+    var out = vec3<f32>(0.0);
+    for (var c = 0u; c < 3u; c = c + 1u) {
+        if change[c] == 0.0 {
+            out[c] = b[c];
+        } else if without[c] > 0.0 {
+            out[c] = b[c] * (lit[c] / without[c]);
+        } else {
+            out[c] = b[c] + change[c];
+        }
+    }
+    return max(out, vec3<f32>(0.0));
+}
+
+@fragment
+fn fs_geometry(in: GeometryOut, @builtin(front_facing) front: bool) -> FragmentOut {
+    // Derivatives first, in uniform control flow.
+    let dx = dpdx(in.world);
+    let dy = dpdy(in.world);
+    let o = objects[in.object];
+    let m = materials[in.material];
+    let wo = normalize(frame.camera_position.xyz - in.world);
+    let f = facing(in.normal, dx, dy, wo, front);
+    let pixel = in.clip.xy;
+    let pixel_noise = noise(floor(pixel));
+    var out: FragmentOut;
+    if o.flags.x == 1u {
+        out.radiance = vec4<f32>(shade_virtual(m, in.world, f, wo, pixel_noise), 1.0);
+        out.coverage = vec4<f32>(1.0, 0.0, 0.0, 1.0);
+    } else {
+        let b = background_surface(pixel, in.world, dx, dy);
+        out.radiance = vec4<f32>(composite_real(m, in.world, f, wo, b, pixel_noise), 1.0);
+        out.coverage = vec4<f32>(0.0, 0.0, 0.0, 1.0);
+    }
+    return out;
+}
+
+struct SkyOut {
+    @builtin(position) clip: vec4<f32>,
+};
+
+@vertex
+fn vs_sky(@builtin(vertex_index) index: u32) -> SkyOut {
+    let x = f32((index << 1u) & 2u) * 2.0 - 1.0;
+    let y = f32(index & 2u) * 2.0 - 1.0;
+    var out: SkyOut;
+    // Depth 0: the far plane of the reversed depth range.
+    out.clip = vec4<f32>(x, y, 0.0, 1.0);
+    return out;
+}
+
+@fragment
+fn fs_sky(in: SkyOut) -> FragmentOut {
+    var out: FragmentOut;
+    out.radiance = vec4<f32>(background_sky(in.clip.xy), 1.0);
+    out.coverage = vec4<f32>(0.0, 0.0, 0.0, 1.0);
+    return out;
+}

@@ -1,0 +1,421 @@
+//! One frame of the scene viewer, the same code in the window and headless: what is redrawn and
+//! what is kept (see `shadow_atlas.rs`), the passes in order, and their timings.
+//!
+//! Per frame: the object transforms and the frame uniform are written; the real shadow atlas is
+//! drawn when the lights changed or the objects left its region; the virtual atlas when the
+//! lights changed or an object moved; then the scene pass and the display transform.
+
+use glam::{Affine3A, Vec3};
+use ibl_core::tonemap::Display;
+use ibl_scene::Background;
+use ibl_scene::description::CompositeRule;
+
+use crate::ViewerError;
+use crate::display_pass::DisplayPass;
+use crate::environment_maps::EnvironmentMaps;
+use crate::frame_targets::FrameTargets;
+use crate::gpu::GpuContext;
+use crate::gpu_scene::{FrameUniform, GpuLight, GpuObject, GpuScene, mat3_columns, vec4};
+use crate::lighting::SceneLighting;
+use crate::scene_model::SceneModel;
+use crate::scene_pass::{ScenePass, ScenePassInputs};
+use crate::shadow_atlas::ShadowAtlases;
+use crate::textures::{HdrTexture, black_texture, upload_hdr};
+use crate::timing::{PassTimer, PassTimes, SCENE_PASSES};
+use crate::view_camera::OutputCamera;
+
+/// Where the glossy lobe's light comes from.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum GlossySource {
+    /// The directional lights, with their shadows (as `ibl render` lights glossy surfaces).
+    #[default]
+    Lights,
+    /// The probe prefiltered through the Phong mip chain (unshadowed reflections; the lights then
+    /// light only the diffuse part).
+    Environment,
+}
+
+/// How to draw a frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SceneFrameSettings {
+    /// The camera at the output size.
+    pub camera: OutputCamera,
+    /// Exposure and tone curve.
+    pub display: Display,
+    /// Glossy reflections.
+    pub glossy: GlossySource,
+    /// Background rays per pixel axis (4, as `ibl render`; 1 is faster).
+    pub background_rays: u32,
+    /// Shadow map side per light, texels (shrunk when the atlas would be too large).
+    pub shadow_tile: u32,
+    /// The selected object (tinted in the overlay).
+    pub selected: Option<usize>,
+}
+
+/// What a frame did.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FrameReport {
+    /// Seconds of CPU work to record and submit the frame.
+    pub cpu_seconds: f64,
+    /// Whether the real atlas was drawn.
+    pub drew_real_shadows: bool,
+    /// Whether the virtual atlas was drawn.
+    pub drew_virtual_shadows: bool,
+}
+
+/// The GPU state of a scene.
+pub struct SceneRenderer {
+    gpu_scene: GpuScene,
+    environment: EnvironmentMaps,
+    scene_pass: ScenePass,
+    display: DisplayPass,
+    shadows: ShadowAtlases,
+    ambient: HdrTexture,
+    photo: HdrTexture,
+    targets: FrameTargets,
+    bind_group: wgpu::BindGroup,
+    lighting: Option<SceneLighting>,
+    gpu_lights: Vec<GpuLight>,
+    /// Placements the virtual atlas was drawn with.
+    drawn_placements: Option<Vec<Affine3A>>,
+    /// Whether the lights changed since the atlases were drawn.
+    lights_changed: bool,
+    timer: Option<PassTimer>,
+    frame_number: u32,
+    /// Pass times of the latest frame whose timestamps were read.
+    pub last_pass_times: Option<PassTimes>,
+}
+
+fn photo_texture(
+    gpu: &GpuContext,
+    model: &SceneModel,
+    width: u32,
+    height: u32,
+) -> Result<HdrTexture, ViewerError> {
+    match &model.scene.background {
+        Background::Photo(_) => {
+            let image = ibl_render::background::background_image(&model.scene, width, height)
+                .map_err(|e| ViewerError::Parameter(e.to_string()))?;
+            Ok(upload_hdr(
+                &gpu.device,
+                &gpu.queue,
+                &image,
+                "background photo",
+                1,
+                wgpu::TextureUsages::empty(),
+            ))
+        }
+        Background::Panorama => Ok(black_texture(&gpu.device, &gpu.queue, "no photo")),
+    }
+}
+
+impl SceneRenderer {
+    /// Uploads a scene for frames of `width x height`.
+    pub fn new(
+        gpu: &GpuContext,
+        model: &SceneModel,
+        width: u32,
+        height: u32,
+        shadow_tile: u32,
+    ) -> Result<SceneRenderer, ViewerError> {
+        let targets = FrameTargets::new(gpu, width, height)?;
+        let gpu_scene = GpuScene::new(gpu, &model.geometry);
+        let environment = EnvironmentMaps::new(gpu, &model.scene.probe.radiance);
+        let scene_pass = ScenePass::new(gpu);
+        let shadows = ShadowAtlases::new(gpu, 1, shadow_tile);
+        let ambient = black_texture(&gpu.device, &gpu.queue, "no ambient");
+        let photo = photo_texture(gpu, model, width, height)?;
+        let bind_group = scene_pass.bind_group(
+            gpu,
+            &gpu_scene,
+            &ScenePassInputs {
+                environment: &environment,
+                ambient: &ambient,
+                photo: &photo,
+                shadows: &shadows,
+            },
+        );
+        gpu.take_errors()?;
+        Ok(SceneRenderer {
+            gpu_scene,
+            environment,
+            scene_pass,
+            display: DisplayPass::new(gpu),
+            shadows,
+            ambient,
+            photo,
+            targets,
+            bind_group,
+            lighting: None,
+            gpu_lights: Vec::new(),
+            drawn_placements: None,
+            lights_changed: true,
+            timer: PassTimer::new(gpu, &SCENE_PASSES),
+            frame_number: 0,
+            last_pass_times: None,
+        })
+    }
+
+    fn rebind(&mut self, gpu: &GpuContext) {
+        self.bind_group = self.scene_pass.bind_group(
+            gpu,
+            &self.gpu_scene,
+            &ScenePassInputs {
+                environment: &self.environment,
+                ambient: &self.ambient,
+                photo: &self.photo,
+                shadows: &self.shadows,
+            },
+        );
+    }
+
+    /// The frame's textures.
+    pub fn targets(&self) -> &FrameTargets {
+        &self.targets
+    }
+
+    /// The lighting drawn now.
+    pub fn lighting(&self) -> Option<&SceneLighting> {
+        self.lighting.as_ref()
+    }
+
+    /// Shadow map side per light now, texels.
+    pub fn shadow_tile(&self) -> u32 {
+        self.shadows.tile()
+    }
+
+    /// Changes the output size (no-op when equal).
+    pub fn resize(
+        &mut self,
+        gpu: &GpuContext,
+        model: &SceneModel,
+        width: u32,
+        height: u32,
+    ) -> Result<(), ViewerError> {
+        if self.targets.size == (width, height) {
+            return Ok(());
+        }
+        self.targets = FrameTargets::new(gpu, width, height)?;
+        self.photo = photo_texture(gpu, model, width, height)?;
+        self.rebind(gpu);
+        Ok(())
+    }
+
+    /// Replaces the lights (from the lighting worker).
+    pub fn set_lighting(&mut self, gpu: &GpuContext, lighting: SceneLighting) {
+        self.ambient = match &lighting.ambient {
+            Some(map) => upload_hdr(
+                &gpu.device,
+                &gpu.queue,
+                map,
+                "ambient irradiance",
+                1,
+                wgpu::TextureUsages::empty(),
+            ),
+            None => black_texture(&gpu.device, &gpu.queue, "no ambient"),
+        };
+        self.lighting = Some(lighting);
+        self.lights_changed = true;
+        self.rebind(gpu);
+    }
+
+    /// Rewrites the materials (after an edit).
+    pub fn update_materials(&self, gpu: &GpuContext, model: &SceneModel) {
+        self.gpu_scene.write_materials(gpu, &model.materials());
+    }
+
+    fn frame_uniform(
+        &self,
+        model: &SceneModel,
+        settings: &SceneFrameSettings,
+        lights: u32,
+    ) -> FrameUniform {
+        let c = &settings.camera;
+        let (w, h) = self.targets.size;
+        let probe = &model.scene.probe;
+        let description = &model.description;
+        let atlas = |a: &crate::shadow_atlas::Atlas| a.size();
+        let (rw, rh) = atlas(&self.shadows.real);
+        let (vw, vh) = atlas(&self.shadows.virtual_objects);
+        FrameUniform {
+            clip_from_world: c.clip_from_world().to_cols_array_2d(),
+            world_from_camera: mat3_columns(c.world_from_camera),
+            camera_position: vec4(c.position, 1.0),
+            intrinsics: [
+                c.focal_px.x,
+                c.focal_px.y,
+                c.principal_px.x,
+                c.principal_px.y,
+            ],
+            probe_from_world: mat3_columns(probe.world_from_probe.transpose()),
+            probe_position: vec4(probe.position, self.environment.scale),
+            viewport: [w as f32, h as f32, 1.0 / w as f32, 1.0 / h as f32],
+            counts: [
+                lights,
+                match description.render.composite {
+                    CompositeRule::Difference => 0,
+                    CompositeRule::Ratio => 1,
+                },
+                match description.lighting.shadows {
+                    ibl_scene::ShadowKind::Hard => 0,
+                    ibl_scene::ShadowKind::Soft => 1,
+                },
+                match model.scene.background {
+                    Background::Panorama => 0,
+                    Background::Photo(_) => 1,
+                },
+            ],
+            options: [
+                match settings.glossy {
+                    GlossySource::Lights => 0,
+                    GlossySource::Environment => 1,
+                },
+                u32::from(self.lighting.as_ref().is_some_and(|l| l.ambient.is_some())),
+                settings.background_rays.clamp(1, 8),
+                self.frame_number,
+            ],
+            environment: [
+                self.environment.first_exponent,
+                self.environment.levels as f32,
+                self.photo.scale,
+                self.ambient.scale,
+            ],
+            atlas: [rw as f32, rh as f32, vw as f32, vh as f32],
+        }
+    }
+
+    /// Draws a frame of `model` and submits it.
+    pub fn render(
+        &mut self,
+        gpu: &GpuContext,
+        model: &SceneModel,
+        settings: &SceneFrameSettings,
+    ) -> FrameReport {
+        let started = std::time::Instant::now();
+        let count = self.lighting.as_ref().map_or(0, |l| l.lights.len()) as u32;
+        // Atlases sized for the lights and the requested tile.
+        let wanted = crate::light_space::AtlasLayout::new(
+            count.max(1),
+            settings.shadow_tile,
+            gpu.max_texture_side(),
+        );
+        if wanted != self.shadows.real.layout {
+            self.shadows = ShadowAtlases::new(gpu, count.max(1), settings.shadow_tile);
+            self.lights_changed = true;
+            self.rebind(gpu);
+        }
+        let placements: Vec<Affine3A> = (0..model.object_count())
+            .map(|i| model.world_from_load(i))
+            .collect();
+        let sphere = model
+            .objects_sphere()
+            .or_else(|| {
+                model
+                    .geometry
+                    .real_bounds()
+                    .map(|(lo, hi)| crate::shadow_atlas::bounding_sphere(lo, hi))
+            })
+            .unwrap_or((Vec3::ZERO, 1.0));
+        let moved = self.drawn_placements.as_ref() != Some(&placements);
+        let mut draw_real = self.lights_changed;
+        if moved || self.lights_changed {
+            let lights = self.lighting.as_ref().map_or(&[][..], |l| &l.lights[..]);
+            let (gpu_lights, region_moved) = self.shadows.fit(
+                lights,
+                model.description.lighting.shadows,
+                sphere,
+                model.geometry.real_bounds(),
+            );
+            draw_real |= region_moved;
+            if self.gpu_scene.write_lights(gpu, &gpu_lights) {
+                self.rebind(gpu);
+            }
+            self.gpu_lights = gpu_lights;
+        }
+        let mut objects = vec![GpuObject::new(Affine3A::IDENTITY, false, false)];
+        objects.extend(
+            placements
+                .iter()
+                .enumerate()
+                .map(|(i, &m)| GpuObject::new(m, true, settings.selected == Some(i))),
+        );
+        self.gpu_scene.write_transforms(gpu, &objects);
+        let uniform = self.frame_uniform(model, settings, count);
+        self.gpu_scene.write_frame(gpu, &uniform);
+
+        let mut encoder = gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("scene frame"),
+            });
+        let draw_virtual = moved || self.lights_changed;
+        if draw_real && count > 0 {
+            let t = self.timer.as_mut().and_then(|t| t.writes(0));
+            self.shadows
+                .draw_real(gpu, &mut encoder, &self.gpu_scene, count, t);
+        }
+        if draw_virtual && count > 0 {
+            let t = self.timer.as_mut().and_then(|t| t.writes(1));
+            self.shadows
+                .draw_virtual(gpu, &mut encoder, &self.gpu_scene, count, t);
+        }
+        {
+            let t = self.timer.as_mut().and_then(|t| t.writes(2));
+            self.scene_pass.record(
+                &mut encoder,
+                &self.targets,
+                &self.gpu_scene,
+                &self.bind_group,
+                t,
+            );
+        }
+        clear_overlay(&mut encoder, &self.targets);
+        {
+            let t = self.timer.as_mut().and_then(|t| t.writes(3));
+            self.display
+                .record(gpu, &mut encoder, &self.targets, &settings.display, t);
+        }
+        if let Some(timer) = self.timer.as_mut() {
+            timer.resolve(&mut encoder);
+        }
+        gpu.queue.submit([encoder.finish()]);
+        if let Some(timer) = self.timer.as_mut() {
+            timer.after_submit();
+        }
+        self.lights_changed = false;
+        self.drawn_placements = Some(placements);
+        self.frame_number = self.frame_number.wrapping_add(1);
+        FrameReport {
+            cpu_seconds: started.elapsed().as_secs_f64(),
+            drew_real_shadows: draw_real && count > 0,
+            drew_virtual_shadows: draw_virtual && count > 0,
+        }
+    }
+
+    /// Reads the pass times of the last frame (waiting for them with `wait`).
+    pub fn read_pass_times(&mut self, gpu: &GpuContext, wait: bool) -> Option<PassTimes> {
+        let times = self.timer.as_mut()?.read(gpu, wait)?;
+        self.last_pass_times = Some(times.clone());
+        Some(times)
+    }
+}
+
+/// Clears the overlay target (nothing is drawn over a scene frame yet).
+fn clear_overlay(encoder: &mut wgpu::CommandEncoder, targets: &FrameTargets) {
+    let _pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("overlay clear"),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view: &targets.overlay_view,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations {
+                load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                store: wgpu::StoreOp::Store,
+            },
+        })],
+        depth_stencil_attachment: None,
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
+}

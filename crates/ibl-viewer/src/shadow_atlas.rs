@@ -1,0 +1,429 @@
+//! A shadow map for every light, packed into two depth atlases (`shadow_atlas.wgsl` draws them,
+//! `shadow_lookup.wgsl` reads them), designed around what moves:
+//!
+//! - the **real atlas** holds the real (local) geometry as each light sees it. That geometry
+//!   never moves, so the atlas is drawn only when the lights change or the virtual objects leave
+//!   the region it covers: a sphere of [`REGION_FACTOR`] times the objects' bounding radius about
+//!   them (the receivers that need real casters are the objects themselves and the real surfaces
+//!   their shadows fall on). Its depth slab spans the whole real geometry along each light.
+//! - the **virtual atlas** holds only the virtual objects, each tile fitted tightly around their
+//!   bounding sphere (so a 512-texel tile resolves a 0.5 m object to about a millimetre). It is
+//!   drawn only when an object moved or the lights changed, in one instanced draw per object for
+//!   all lights at once.
+//!
+//! A receiver's visibility of light `i` is the product of its visibility in both atlases
+//! (ibl-render's shadow rays test both layers: blocked by either is blocked). Real surfaces whose
+//! projection falls outside every virtual tile skip the virtual look-ups entirely, and lights
+//! behind a surface are skipped before any look-up (the shader's loops): with sixteen lights
+//! most real pixels cost sixteen dot products and tile tests, not thirty-two texture reads.
+//!
+//! Soft shadows widen each virtual tile by `1 + 2 tan a` (at most 3x) so a penumbra of cone
+//! half-angle `a` fits in it.
+
+use glam::Vec3;
+use ibl_render::lighting::DirectionalLight;
+use ibl_scene::ShadowKind;
+
+use crate::gpu::{DEPTH_FORMAT, GpuContext};
+use crate::gpu_scene::{GpuLight, GpuScene, vec4};
+use crate::light_space::{AtlasLayout, ShadowProjection, box_depths};
+use crate::scene_geometry::{VERTEX_ATTRIBUTES, Vertex};
+
+/// The real atlas covers this many times the virtual objects' bounding radius about them.
+pub const REGION_FACTOR: f32 = 4.0;
+
+/// One atlas texture.
+#[derive(Debug)]
+pub struct Atlas {
+    /// Its tiles.
+    pub layout: AtlasLayout,
+    /// The depth texture.
+    pub texture: wgpu::Texture,
+    /// A view of it.
+    pub view: wgpu::TextureView,
+}
+
+impl Atlas {
+    fn new(gpu: &GpuContext, label: &str, layout: AtlasLayout) -> Atlas {
+        let (w, h) = layout.size();
+        let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d {
+                width: w,
+                height: h,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: DEPTH_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        });
+        let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
+        Atlas {
+            layout,
+            texture,
+            view,
+        }
+    }
+
+    /// Width and height, texels.
+    pub fn size(&self) -> (u32, u32) {
+        self.layout.size()
+    }
+}
+
+/// The sphere `(centre, radius)` enclosing a box.
+pub fn bounding_sphere(lo: Vec3, hi: Vec3) -> (Vec3, f32) {
+    ((lo + hi) * 0.5, ((hi - lo) * 0.5).length().max(1e-4))
+}
+
+/// Tan of a light's cone half-angle (0 for a point-like light), capped at 10 (84 degrees).
+pub fn cone_tangent(light: &DirectionalLight) -> f32 {
+    light.cone.map_or(0.0, |cone| {
+        let c = cone.cos_half_angle().clamp(-1.0, 1.0);
+        if c <= 0.1 {
+            10.0
+        } else {
+            ((1.0 - c * c).sqrt() / c).min(10.0)
+        }
+    })
+}
+
+/// What the atlases were last fitted to.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Region {
+    /// Centre of the real atlas's region.
+    pub centre: Vec3,
+    /// Its radius.
+    pub radius: f32,
+}
+
+impl Region {
+    /// Whether a sphere (the virtual objects now) is still well inside the region, and not much
+    /// smaller or larger than the one it was fitted for.
+    pub fn holds(&self, centre: Vec3, radius: f32) -> bool {
+        let fitted = self.radius / REGION_FACTOR;
+        (centre - self.centre).length() + radius <= 0.5 * self.radius
+            && radius <= 1.25 * fitted
+            && radius >= 0.5 * fitted
+    }
+}
+
+/// Both atlases and their pipelines.
+#[derive(Debug)]
+pub struct ShadowAtlases {
+    /// Real geometry.
+    pub real: Atlas,
+    /// Virtual objects.
+    pub virtual_objects: Atlas,
+    real_pipeline: wgpu::RenderPipeline,
+    virtual_pipeline: wgpu::RenderPipeline,
+    bind_layout: wgpu::BindGroupLayout,
+    /// The region the real atlas covers now (`None`: never drawn).
+    pub region: Option<Region>,
+}
+
+impl ShadowAtlases {
+    /// Atlases for `lights` lights of `tile` texels each (shrunk to fit the device).
+    pub fn new(gpu: &GpuContext, lights: u32, tile: u32) -> ShadowAtlases {
+        let layout = AtlasLayout::new(lights, tile, gpu.max_texture_side());
+        let device = &gpu.device;
+        let source = format!(
+            "{}\n{}",
+            include_str!("gpu_scene.wgsl"),
+            include_str!("shadow_atlas.wgsl")
+        );
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("shadow_atlas.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(source.into()),
+        });
+        let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::VERTEX,
+            ty,
+            count: None,
+        };
+        let storage = wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only: true },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        };
+        let bind_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("shadow atlas"),
+            entries: &[
+                entry(
+                    0,
+                    wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                ),
+                entry(1, storage),
+                entry(2, storage),
+            ],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("shadow atlas"),
+            bind_group_layouts: &[Some(&bind_layout)],
+            immediate_size: 0,
+        });
+        let pipeline = |entry: &str| {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(entry),
+                layout: Some(&pipeline_layout),
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some(entry),
+                    compilation_options: Default::default(),
+                    buffers: &[Some(wgpu::VertexBufferLayout {
+                        array_stride: std::mem::size_of::<Vertex>() as u64,
+                        step_mode: wgpu::VertexStepMode::Vertex,
+                        attributes: &VERTEX_ATTRIBUTES,
+                    })],
+                },
+                primitive: wgpu::PrimitiveState {
+                    cull_mode: None,
+                    ..Default::default()
+                },
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: DEPTH_FORMAT,
+                    depth_write_enabled: Some(true),
+                    depth_compare: Some(wgpu::CompareFunction::Less),
+                    stencil: wgpu::StencilState::default(),
+                    bias: wgpu::DepthBiasState::default(),
+                }),
+                multisample: wgpu::MultisampleState::default(),
+                fragment: None,
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        ShadowAtlases {
+            real: Atlas::new(gpu, "real shadow atlas", layout),
+            virtual_objects: Atlas::new(gpu, "virtual shadow atlas", layout),
+            real_pipeline: pipeline("vs_real_tile"),
+            virtual_pipeline: pipeline("vs_virtual_atlas"),
+            bind_layout,
+            region: None,
+        }
+    }
+
+    /// The tile side of both atlases, texels.
+    pub fn tile(&self) -> u32 {
+        self.real.layout.tile
+    }
+
+    /// How many lights the atlases hold tiles for.
+    pub fn capacity(&self) -> u32 {
+        self.real.layout.tiles
+    }
+
+    /// The GPU lights: each light's tiles fitted to the scene (see the module notes). `objects`
+    /// is the bounding sphere of the virtual objects now, `real_bounds` the real geometry's box.
+    /// Returns the lights and whether the real region moved (the real atlas must be redrawn).
+    pub fn fit(
+        &mut self,
+        lights: &[DirectionalLight],
+        shadows: ShadowKind,
+        objects: (Vec3, f32),
+        real_bounds: Option<(Vec3, Vec3)>,
+    ) -> (Vec<GpuLight>, bool) {
+        let (centre, radius) = objects;
+        let region = match self.region {
+            Some(r) if r.holds(centre, radius) => r,
+            _ => Region {
+                centre,
+                radius: radius * REGION_FACTOR,
+            },
+        };
+        let moved = self.region != Some(region);
+        self.region = Some(region);
+        let tile = self.tile() as f32;
+        let gpu_lights = lights
+            .iter()
+            .enumerate()
+            .map(|(i, light)| {
+                let w = light.direction;
+                let tan_half = cone_tangent(light);
+                let soft = shadows == ShadowKind::Soft && tan_half > 0.0;
+                let across = if soft {
+                    (1.0 + 2.0 * tan_half).min(3.0)
+                } else {
+                    1.05
+                };
+                let virtual_map = ShadowProjection::around_sphere(w, centre, radius, across);
+                let (mut toward, mut away) = real_bounds
+                    .map(|(lo, hi)| box_depths(w, region.centre, lo, hi))
+                    .unwrap_or((0.0, 0.0));
+                toward = toward.max(region.radius);
+                away = away.max(region.radius);
+                let real_map = ShadowProjection::new(w, region.centre, region.radius, toward, away);
+                let index = i as u32;
+                let irradiance = light.irradiance;
+                GpuLight {
+                    direction: vec4(w, if soft { tan_half } else { 0.0 }),
+                    irradiance: [irradiance.r, irradiance.g, irradiance.b, 0.0],
+                    real_map: real_map.map_from_world.to_cols_array_2d(),
+                    real_tile: self.real.layout.uv_rect(index).to_array(),
+                    real_extent: [
+                        real_map.half_extent,
+                        real_map.depth_range,
+                        2.0 * real_map.half_extent / tile,
+                        0.0,
+                    ],
+                    virtual_map: virtual_map.map_from_world.to_cols_array_2d(),
+                    virtual_tile: self.virtual_objects.layout.uv_rect(index).to_array(),
+                    virtual_extent: [
+                        virtual_map.half_extent,
+                        virtual_map.depth_range,
+                        2.0 * virtual_map.half_extent / tile,
+                        0.0,
+                    ],
+                }
+            })
+            .collect();
+        (gpu_lights, moved)
+    }
+
+    fn bind_group(&self, gpu: &GpuContext, scene: &GpuScene) -> wgpu::BindGroup {
+        gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("shadow atlas"),
+            layout: &self.bind_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: scene.frame.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: scene.lights.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: scene.transforms.as_entire_binding(),
+                },
+            ],
+        })
+    }
+
+    fn pass<'a>(
+        encoder: &'a mut wgpu::CommandEncoder,
+        atlas: &'a Atlas,
+        label: &str,
+        timestamps: Option<wgpu::RenderPassTimestampWrites<'a>>,
+    ) -> wgpu::RenderPass<'a> {
+        encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some(label),
+            color_attachments: &[],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &atlas.view,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: timestamps,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        })
+    }
+
+    /// Draws the real geometry into the real atlas, one tile per light.
+    pub fn draw_real(
+        &self,
+        gpu: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        scene: &GpuScene,
+        lights: u32,
+        timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
+    ) {
+        let bind_group = self.bind_group(gpu, scene);
+        let mut pass = Self::pass(encoder, &self.real, "real shadows", timestamps);
+        if scene.real.vertices == 0 {
+            return;
+        }
+        pass.set_pipeline(&self.real_pipeline);
+        pass.set_bind_group(0, &bind_group, &[]);
+        pass.set_vertex_buffer(0, scene.real.buffer.slice(..));
+        let tile = self.real.layout.tile as f32;
+        for i in 0..lights.min(self.capacity()) {
+            let (x, y) = self.real.layout.origin(i);
+            pass.set_viewport(x as f32, y as f32, tile, tile, 0.0, 1.0);
+            pass.draw(0..scene.real.vertices, i..i + 1);
+        }
+    }
+
+    /// Draws the virtual objects into the virtual atlas, all lights in one instanced draw each.
+    pub fn draw_virtual(
+        &self,
+        gpu: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        scene: &GpuScene,
+        lights: u32,
+        timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
+    ) {
+        let bind_group = self.bind_group(gpu, scene);
+        let mut pass = Self::pass(
+            encoder,
+            &self.virtual_objects,
+            "virtual shadows",
+            timestamps,
+        );
+        let lights = lights.min(self.capacity());
+        if lights == 0 {
+            return;
+        }
+        pass.set_pipeline(&self.virtual_pipeline);
+        pass.set_bind_group(0, &bind_group, &[]);
+        for (k, mesh) in scene.objects.iter().enumerate() {
+            if mesh.vertices == 0 {
+                continue;
+            }
+            let object = k as u32 + 1;
+            pass.set_vertex_buffer(0, mesh.buffer.slice(..));
+            pass.draw(0..mesh.vertices, object * lights..(object + 1) * lights);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_region_holds_small_moves_only() {
+        let r = Region {
+            centre: Vec3::ZERO,
+            radius: 4.0,
+        };
+        assert!(r.holds(Vec3::new(0.5, 0.0, 0.0), 1.0));
+        assert!(!r.holds(Vec3::new(1.5, 0.0, 0.0), 1.0));
+        assert!(
+            !r.holds(Vec3::ZERO, 2.0),
+            "scaled up: the tiles would be too coarse"
+        );
+        assert!(
+            !r.holds(Vec3::ZERO, 0.3),
+            "scaled down: refit for resolution"
+        );
+    }
+
+    #[test]
+    fn cone_tangents_follow_the_solid_angle() {
+        let light = |solid_angle: f32| DirectionalLight {
+            direction: Vec3::Y,
+            irradiance: ibl_core::Rgb::ONE,
+            cone: ibl_render::sampling::UniformCone::from_solid_angle(solid_angle),
+        };
+        assert_eq!(cone_tangent(&light(0.0)), 0.0);
+        // A cone of half-angle a has solid angle 2 pi (1 - cos a); a = 30 degrees.
+        let a = 30f32.to_radians();
+        let t = cone_tangent(&light(std::f32::consts::TAU * (1.0 - a.cos())));
+        assert!((t - a.tan()).abs() < 1e-4, "{t}");
+        assert_eq!(cone_tangent(&light(12.0)), 10.0);
+    }
+}

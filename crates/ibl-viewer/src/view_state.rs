@@ -1,0 +1,647 @@
+//! What the window has open (nothing, a probe or a scene) with its renderer, its worker and its
+//! view, and what input does to it. The window ([`crate::window`]) owns one [`Content`].
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use eframe::egui;
+use glam::{Vec2, Vec3};
+use ibl_core::tonemap::Display;
+use ibl_mapping::Mapping;
+use ibl_pipeline::LightingPlan;
+
+use crate::ViewerError;
+use crate::frame_targets::FrameTargets;
+use crate::gpu::GpuContext;
+use crate::lighting::{
+    ProbeOverlay, ProbeOverlayRequest, SceneLighting, SceneLightingRequest, probe_overlay,
+    scene_lighting,
+};
+use crate::panels::PointerInput;
+use crate::probe_model::{ProbeModel, ProbeViewSettings};
+use crate::probe_pass::ProbeProjection;
+use crate::probe_renderer::ProbeRenderer;
+use crate::scene_model::{DragAction, SceneModel};
+use crate::scene_renderer::{GlossySource, SceneFrameSettings, SceneRenderer};
+use crate::view_camera::{OrbitControl, OutputCamera};
+use crate::worker::LatestWorker;
+
+/// A discrete action from the keyboard.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ViewEvent {
+    /// Look along an axis: 0..6 = +X -X +Y -Y +Z -Z.
+    Axis(usize),
+    /// Frame the selection (scene) or reset the view (probe).
+    Frame,
+    /// Clear the selection.
+    Deselect,
+}
+
+/// The probe viewer's state.
+pub struct ProbeState {
+    /// The probe.
+    pub model: ProbeModel,
+    /// What is shown.
+    pub settings: ProbeViewSettings,
+    renderer: ProbeRenderer,
+    worker: LatestWorker<ProbeOverlayRequest, Result<ProbeOverlay, String>>,
+    requested: Option<(ibl_extract::ModelSpec, usize, usize)>,
+    /// Seconds the last overlay took.
+    pub overlay_seconds: f64,
+    /// The direction and radiance under the cursor.
+    pub cursor: Option<(Vec3, ibl_core::Rgb)>,
+}
+
+/// How the scene camera is placed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SceneCamera {
+    /// The scene file's own camera, exactly (letterboxed to its aspect).
+    File,
+    /// A camera the user moved.
+    Orbit(OrbitControl),
+}
+
+/// A drag on an object in progress.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct ObjectDrag {
+    object: usize,
+    action: DragAction,
+    plane_y: f32,
+    last_ray: (Vec3, Vec3),
+}
+
+/// The scene viewer's state.
+pub struct SceneState {
+    /// The scene being edited.
+    pub model: SceneModel,
+    renderer: SceneRenderer,
+    worker: LatestWorker<SceneLightingRequest, Result<SceneLighting, String>>,
+    requested: Option<LightingPlan>,
+    /// The camera.
+    pub camera: SceneCamera,
+    /// Exposure and tone curve.
+    pub display: Display,
+    /// Glossy reflections.
+    pub glossy: GlossySource,
+    /// Background rays per pixel axis.
+    pub background_rays: u32,
+    /// Shadow map side per light, texels.
+    pub shadow_tile: u32,
+    /// The selected object.
+    pub selected: Option<usize>,
+    drag: Option<ObjectDrag>,
+    /// Seconds the last lighting took.
+    pub lighting_seconds: f64,
+    /// Where "save scene" writes.
+    pub save_path: String,
+    /// The camera of the last frame.
+    pub last_camera: Option<OutputCamera>,
+    /// The object under the cursor.
+    pub hovered: Option<usize>,
+}
+
+/// What the window has open.
+pub enum Content {
+    /// Nothing yet: the window asks for a file.
+    Empty,
+    /// A probe.
+    Probe(Box<ProbeState>),
+    /// A scene.
+    Scene(Box<SceneState>),
+}
+
+/// The scene file's save name: `<stem>-edited.toml` beside it.
+pub fn default_save_path(scene: &Path) -> PathBuf {
+    let stem = scene
+        .file_stem()
+        .map_or("scene".to_string(), |s| s.to_string_lossy().into_owned());
+    scene.with_file_name(format!("{stem}-edited.toml"))
+}
+
+impl Content {
+    /// Opens a probe or a scene file (`.toml`).
+    pub fn open(
+        gpu: &GpuContext,
+        path: &Path,
+        mapping: Option<Mapping>,
+        size: (u32, u32),
+        shadow_tile: u32,
+    ) -> Result<Content, ViewerError> {
+        let is_scene = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
+        if is_scene {
+            let model = SceneModel::open(path)?;
+            let renderer = SceneRenderer::new(gpu, &model, size.0, size.1, shadow_tile)?;
+            let display = Display {
+                exposure_stops: crate::headless::auto_exposure(&model),
+                ..Display::default()
+            };
+            let camera = match model.scene.camera {
+                ibl_scene::Camera::Pinhole { .. } => SceneCamera::File,
+                ibl_scene::Camera::Panorama { position, .. } => SceneCamera::Orbit(OrbitControl {
+                    target: position,
+                    distance: 0.0,
+                    yaw: 0.0,
+                    pitch: 0.0,
+                    vertical_fov: 60f32.to_radians(),
+                }),
+            };
+            Ok(Content::Scene(Box::new(SceneState {
+                save_path: default_save_path(path).display().to_string(),
+                model,
+                renderer,
+                worker: LatestWorker::new("ibl-view lights", |r: SceneLightingRequest| {
+                    scene_lighting(&r)
+                }),
+                requested: None,
+                camera,
+                display,
+                glossy: GlossySource::Lights,
+                background_rays: 4,
+                shadow_tile,
+                selected: None,
+                drag: None,
+                lighting_seconds: 0.0,
+                last_camera: None,
+                hovered: None,
+            })))
+        } else {
+            let model = ProbeModel::open(path, mapping)?;
+            let renderer = ProbeRenderer::new(gpu, &model, size.0, size.1)?;
+            let settings = ProbeViewSettings::for_probe(&model.latlong);
+            Ok(Content::Probe(Box::new(ProbeState {
+                model,
+                settings,
+                renderer,
+                worker: LatestWorker::new("ibl-view overlay", |r: ProbeOverlayRequest| {
+                    probe_overlay(&r)
+                }),
+                requested: None,
+                overlay_seconds: 0.0,
+                cursor: None,
+            })))
+        }
+    }
+
+    /// The frame's textures.
+    pub fn targets(&self) -> Option<&FrameTargets> {
+        match self {
+            Content::Empty => None,
+            Content::Probe(p) => Some(p.renderer.targets()),
+            Content::Scene(s) => Some(s.renderer.targets()),
+        }
+    }
+
+    /// Whether lights or overlays are being computed.
+    pub fn busy(&self) -> bool {
+        match self {
+            Content::Empty => false,
+            Content::Probe(p) => p.worker.busy() || p.requested.is_none(),
+            Content::Scene(s) => s.worker.busy() || s.requested.is_none(),
+        }
+    }
+
+    /// Whether the window should keep repainting (a worker result is awaited).
+    pub fn animating(&self) -> bool {
+        self.busy()
+    }
+
+    /// Submits work whose inputs changed and takes finished results.
+    pub fn poll_workers(&mut self, gpu: &GpuContext) -> Result<(), String> {
+        match self {
+            Content::Empty => Ok(()),
+            Content::Probe(p) => {
+                let wanted = (p.settings.spec, p.settings.lights, p.settings.bands);
+                if p.requested != Some(wanted) {
+                    p.worker.submit(ProbeOverlayRequest {
+                        probe: Arc::clone(&p.model.latlong),
+                        spec: wanted.0,
+                        lights: wanted.1,
+                        bands: wanted.2,
+                    });
+                    p.requested = Some(wanted);
+                }
+                match p.worker.poll() {
+                    Some(done) => {
+                        p.overlay_seconds = done.seconds;
+                        let overlay = done.result?;
+                        p.renderer.set_overlay(gpu, overlay);
+                        Ok(())
+                    }
+                    None => Ok(()),
+                }
+            }
+            Content::Scene(s) => {
+                let plan = s.model.lighting_plan();
+                if s.requested.as_ref() != Some(&plan) {
+                    s.worker.submit(SceneLightingRequest {
+                        scene: Arc::clone(&s.model.scene),
+                        plan: plan.clone(),
+                    });
+                    s.requested = Some(plan);
+                }
+                match s.worker.poll() {
+                    Some(done) => {
+                        s.lighting_seconds = done.seconds;
+                        let lighting = done.result?;
+                        s.renderer.set_lighting(gpu, lighting);
+                        Ok(())
+                    }
+                    None => Ok(()),
+                }
+            }
+        }
+    }
+
+    /// The frame size for an area of `available` points at `scale` pixels per point: the whole
+    /// area, or the largest rectangle of the scene camera's aspect inside it.
+    pub fn render_size(&self, available: egui::Vec2, scale: f32) -> (u32, u32) {
+        let w = (available.x * scale).round().max(1.0);
+        let h = (available.y * scale).round().max(1.0);
+        let (w, h) = match self {
+            Content::Scene(s) if s.camera == SceneCamera::File => match s.model.scene.camera {
+                ibl_scene::Camera::Pinhole {
+                    reference_size: (rw, rh),
+                    ..
+                } => {
+                    let aspect = rw as f32 / rh as f32;
+                    if w / h > aspect {
+                        (h * aspect, h)
+                    } else {
+                        (w, w / aspect)
+                    }
+                }
+                ibl_scene::Camera::Panorama { .. } => (w, h),
+            },
+            _ => (w, h),
+        };
+        let max = crate::frame_targets::MAX_OUTPUT_SIDE as f32;
+        (
+            w.round().clamp(1.0, max) as u32,
+            h.round().clamp(1.0, max) as u32,
+        )
+    }
+
+    /// Where a frame of `size` pixels is shown inside `rect`: centred, at its own aspect.
+    pub fn display_rect(&self, rect: egui::Rect, size: (u32, u32)) -> egui::Rect {
+        let aspect = size.0 as f32 / size.1.max(1) as f32;
+        let (w, h) = if rect.width() / rect.height().max(1.0) > aspect {
+            (rect.height() * aspect, rect.height())
+        } else {
+            (rect.width(), rect.width() / aspect)
+        };
+        egui::Rect::from_center_size(rect.center(), egui::vec2(w, h))
+    }
+
+    /// Draws a frame of `size` pixels; `scale` is pixels per point (marker sizes).
+    pub fn draw(
+        &mut self,
+        gpu: &GpuContext,
+        size: (u32, u32),
+        scale: f32,
+    ) -> Result<(), ViewerError> {
+        match self {
+            Content::Empty => Ok(()),
+            Content::Probe(p) => {
+                p.renderer.resize(gpu, size.0, size.1)?;
+                p.renderer.render(gpu, &p.settings, scale);
+                Ok(())
+            }
+            Content::Scene(s) => {
+                s.renderer.resize(gpu, &s.model, size.0, size.1)?;
+                let camera = s.camera(size);
+                s.last_camera = Some(camera);
+                let settings = SceneFrameSettings {
+                    camera,
+                    display: s.display,
+                    glossy: s.glossy,
+                    background_rays: s.background_rays,
+                    shadow_tile: s.shadow_tile,
+                    selected: s.selected,
+                };
+                s.renderer.render(gpu, &s.model, &settings);
+                let _ = s.renderer.read_pass_times(gpu, false);
+                Ok(())
+            }
+        }
+    }
+
+    /// Handles a key.
+    pub fn handle(&mut self, event: ViewEvent) {
+        match (self, event) {
+            (Content::Probe(p), ViewEvent::Axis(axis)) => {
+                let (yaw, pitch) = axis_view(axis);
+                p.settings.orbit.yaw = yaw;
+                p.settings.orbit.pitch = pitch;
+                p.settings.projection = ProbeProjection::LookAround;
+            }
+            (Content::Probe(p), ViewEvent::Frame) => {
+                p.settings.orbit.yaw = 0.0;
+                p.settings.orbit.pitch = 0.0;
+            }
+            (Content::Scene(s), ViewEvent::Frame) => s.frame_selection(),
+            (Content::Scene(s), ViewEvent::Deselect) => s.selected = None,
+            _ => {}
+        }
+    }
+
+    /// What the mouse did over the frame shown in `shown`.
+    pub fn pointer(&mut self, response: &egui::Response, shown: egui::Rect, input: &PointerInput) {
+        match self {
+            Content::Empty => {}
+            Content::Probe(p) => p.pointer(response, shown, input),
+            Content::Scene(s) => s.pointer(response, shown, input),
+        }
+    }
+
+    /// Saves the frame as EXR and PNG in the working directory.
+    pub fn save_frame(&self, gpu: &GpuContext) -> Result<Vec<String>, ViewerError> {
+        let (targets, source) = match self {
+            Content::Empty => return Err(ViewerError::Parameter("nothing is open".into())),
+            Content::Probe(p) => (p.renderer.targets(), &p.model.path),
+            Content::Scene(s) => (s.renderer.targets(), &s.model.path),
+        };
+        let images = targets.read_back(gpu)?;
+        let stem = source
+            .file_stem()
+            .map_or("frame".to_string(), |s| s.to_string_lossy().into_owned());
+        let (png, exr) = (1..10_000)
+            .map(|n| {
+                (
+                    PathBuf::from(format!("{stem}-frame-{n}.png")),
+                    PathBuf::from(format!("{stem}-frame-{n}.exr")),
+                )
+            })
+            .find(|(png, exr)| !png.exists() && !exr.exists())
+            .ok_or_else(|| ViewerError::Parameter("no free frame file name".into()))?;
+        let bytes = ibl_io::ldr::encode_png(&images.display).map_err(|e| e.with_path(&png))?;
+        ibl_io::write_atomically(&png, &bytes)?;
+        ibl_io::write_image(&exr, &images.radiance, &ibl_io::WriteOptions::default())?;
+        Ok(vec![png.display().to_string(), exr.display().to_string()])
+    }
+
+    /// Saves the edited scene to `path` (default: the panel's save path); `Ok(None)` when no
+    /// scene is open.
+    pub fn save_scene(&self, path: Option<PathBuf>) -> Result<Option<PathBuf>, ViewerError> {
+        let Content::Scene(s) = self else {
+            return Ok(None);
+        };
+        let path = path.unwrap_or_else(|| PathBuf::from(&s.save_path));
+        s.save(&path)?;
+        Ok(Some(path))
+    }
+}
+
+/// Yaw and pitch that look along axis `k` (0..6 = +X -X +Y -Y +Z -Z).
+pub fn axis_view(k: usize) -> (f32, f32) {
+    use std::f32::consts::{FRAC_PI_2, PI};
+    let up = 89f32.to_radians();
+    match k {
+        0 => (-FRAC_PI_2, 0.0),
+        1 => (FRAC_PI_2, 0.0),
+        2 => (0.0, up),
+        3 => (0.0, -up),
+        4 => (PI, 0.0),
+        _ => (0.0, 0.0),
+    }
+}
+
+/// Pixel coordinates in a frame of `size` of a pointer position over the shown rectangle.
+fn frame_pixel(pos: egui::Pos2, shown: egui::Rect, size: (u32, u32)) -> Vec2 {
+    Vec2::new(
+        (pos.x - shown.min.x) / shown.width() * size.0 as f32,
+        (pos.y - shown.min.y) / shown.height() * size.1 as f32,
+    )
+}
+
+impl ProbeState {
+    fn pointer(&mut self, response: &egui::Response, shown: egui::Rect, input: &PointerInput) {
+        let size = self.renderer.targets().size;
+        let per_pixel = self.settings.orbit.vertical_fov / shown.height().max(1.0);
+        if response.dragged_by(egui::PointerButton::Primary)
+            && self.settings.projection == ProbeProjection::LookAround
+        {
+            let d = response.drag_delta();
+            self.settings.orbit.turn(d.x * per_pixel, d.y * per_pixel);
+        }
+        if response.hovered() && input.scroll != 0.0 {
+            let fov = self.settings.orbit.vertical_fov * (-input.scroll * 0.002).exp();
+            self.settings.orbit.vertical_fov = fov.clamp(10f32.to_radians(), 150f32.to_radians());
+        }
+        self.cursor = response
+            .hover_pos()
+            .filter(|p| shown.contains(*p))
+            .map(|p| {
+                let px = frame_pixel(p, shown, size);
+                let d = self.settings.direction_at(px.x, px.y, size.0, size.1);
+                (d, self.model.radiance_towards(d))
+            });
+    }
+}
+
+impl SceneState {
+    /// The camera of a frame of `size`.
+    pub fn camera(&self, size: (u32, u32)) -> OutputCamera {
+        match self.camera {
+            SceneCamera::File => crate::headless::scene_camera(&self.model, size.0, size.1),
+            SceneCamera::Orbit(orbit) => orbit.camera(size.0, size.1),
+        }
+    }
+
+    /// Whether the camera may move (a photograph fixes it).
+    pub fn camera_movable(&self) -> bool {
+        matches!(self.model.scene.background, ibl_scene::Background::Panorama)
+    }
+
+    /// The orbit equivalent to the current view (switching from the file's camera).
+    fn orbit(&mut self) -> &mut OrbitControl {
+        if self.camera == SceneCamera::File {
+            let c = self.last_camera.unwrap_or_else(|| self.camera((640, 480)));
+            let target = self.model.objects_sphere().map_or(
+                c.position + c.ray(0.5 * c.size.0 as f32, 0.5 * c.size.1 as f32),
+                |(p, _)| p,
+            );
+            let forward = c.ray(0.5 * c.size.0 as f32, 0.5 * c.size.1 as f32);
+            let distance = (target - c.position).dot(forward).max(0.1);
+            self.camera = SceneCamera::Orbit(OrbitControl::from_view(
+                c.position,
+                forward,
+                distance,
+                c.vertical_fov(),
+            ));
+        }
+        match &mut self.camera {
+            SceneCamera::Orbit(o) => o,
+            SceneCamera::File => unreachable!("switched to an orbit above"),
+        }
+    }
+
+    fn frame_selection(&mut self) {
+        let Some((centre, radius)) = self.model.objects_sphere() else {
+            return;
+        };
+        if !self.camera_movable() {
+            return;
+        }
+        let orbit = self.orbit();
+        orbit.target = centre;
+        orbit.distance = (radius / (0.5 * orbit.vertical_fov).tan() * 1.3).max(0.05);
+    }
+
+    fn ray_at(&self, camera: &OutputCamera, px: Vec2) -> (Vec3, Vec3) {
+        (camera.position, camera.ray(px.x, px.y))
+    }
+
+    fn pointer(&mut self, response: &egui::Response, shown: egui::Rect, input: &PointerInput) {
+        let Some(camera) = self.last_camera else {
+            return;
+        };
+        let size = camera.size;
+        let pixel = |p: egui::Pos2| frame_pixel(p, shown, size);
+        let pick = |s: &Self, p: egui::Pos2| {
+            let (o, d) = s.ray_at(&camera, pixel(p));
+            s.model.pick(o, d).map(|(i, t)| (i, o + d * t))
+        };
+        self.hovered = response
+            .hover_pos()
+            .and_then(|p| pick(self, p))
+            .map(|(i, _)| i);
+        if response.drag_started_by(egui::PointerButton::Primary)
+            && let Some(p) = response.interact_pointer_pos()
+        {
+            self.drag = pick(self, p).map(|(object, at)| ObjectDrag {
+                object,
+                action: if input.shift {
+                    DragAction::Rotate
+                } else if input.ctrl {
+                    DragAction::Scale
+                } else {
+                    DragAction::Move
+                },
+                plane_y: at.y,
+                last_ray: self.ray_at(&camera, pixel(p)),
+            });
+            if let Some(drag) = self.drag {
+                self.selected = Some(drag.object);
+            }
+        }
+        if response.dragged_by(egui::PointerButton::Primary) {
+            let d = response.drag_delta();
+            match (self.drag, response.interact_pointer_pos()) {
+                (Some(mut drag), Some(p)) => {
+                    if drag.action == DragAction::Move {
+                        let ray = self.ray_at(&camera, pixel(p));
+                        let reach = self
+                            .model
+                            .objects_sphere()
+                            .map_or(100.0, |(_, r)| 200.0 * r);
+                        self.model
+                            .drag_to(drag.object, drag.plane_y, drag.last_ray, ray, reach);
+                        drag.last_ray = ray;
+                        self.drag = Some(drag);
+                    } else {
+                        self.model.drag_pixels(drag.object, drag.action, d.x, d.y);
+                    }
+                }
+                _ if self.camera_movable() => {
+                    let k = 0.005;
+                    self.orbit().turn(-d.x * k, -d.y * k);
+                }
+                _ => {}
+            }
+        }
+        if response.drag_stopped() {
+            self.drag = None;
+        }
+        let panning = response.dragged_by(egui::PointerButton::Secondary)
+            || response.dragged_by(egui::PointerButton::Middle);
+        if panning && self.camera_movable() {
+            let d = response.drag_delta();
+            let orbit = self.orbit();
+            let s =
+                2.0 * orbit.distance.max(0.1) * (0.5 * orbit.vertical_fov).tan() / shown.height();
+            orbit.pan(-d.x * s, d.y * s);
+        }
+        if response.hovered() && input.scroll != 0.0 && self.camera_movable() {
+            let factor = (-input.scroll * 0.002).exp();
+            let orbit = self.orbit();
+            if orbit.distance > 0.0 {
+                orbit.dolly(factor);
+            } else {
+                orbit.vertical_fov = (orbit.vertical_fov * factor).clamp(0.2, 2.6);
+            }
+        }
+        if response.clicked() {
+            self.selected = response
+                .interact_pointer_pos()
+                .and_then(|p| pick(self, p))
+                .map(|(i, _)| i);
+        }
+    }
+
+    /// Writes the edited scene to `path` (refusing to write over any file the scene reads).
+    pub fn save(&self, path: &Path) -> Result<(), ViewerError> {
+        let mut description = self.model.description.clone();
+        if let SceneCamera::Orbit(orbit) = self.camera
+            && self.camera_movable()
+        {
+            let size = self.last_camera.map_or((640, 480), |c| c.size);
+            description.camera = Some(crate::scene_save::camera_description(
+                &orbit,
+                description.camera.as_ref(),
+                size,
+            ));
+        }
+        let inputs: Vec<&Path> = self.model.inputs.iter().map(PathBuf::as_path).collect();
+        ibl_io::ensure_output_is_not_input(path, &inputs)?;
+        let text = crate::scene_save::scene_text(&self.model, &description, path)?;
+        ibl_io::write_atomically(path, text.as_bytes())?;
+        Ok(())
+    }
+
+    /// The lighting drawn now.
+    pub fn lighting(&self) -> Option<&SceneLighting> {
+        self.renderer.lighting()
+    }
+
+    /// Shadow map side per light drawn now.
+    pub fn drawn_shadow_tile(&self) -> u32 {
+        self.renderer.shadow_tile()
+    }
+
+    /// GPU pass times of a recent frame.
+    pub fn pass_times(&self) -> Option<&crate::timing::PassTimes> {
+        self.renderer.last_pass_times.as_ref()
+    }
+
+    /// Rewrites the materials after an edit.
+    pub fn materials_changed(&self, gpu: &GpuContext) {
+        self.renderer.update_materials(gpu, &self.model);
+    }
+
+    /// The last frame, read back.
+    pub fn read_frame(
+        &self,
+        gpu: &GpuContext,
+    ) -> Result<crate::frame_targets::FrameImages, ViewerError> {
+        self.renderer.targets().read_back(gpu)
+    }
+
+    /// Whether lights are being computed.
+    pub fn lighting_busy(&self) -> bool {
+        self.worker.busy()
+    }
+}
+
+impl ProbeState {
+    /// The overlay drawn now.
+    pub fn overlay(&self) -> Option<&ProbeOverlay> {
+        self.renderer.overlay()
+    }
+
+    /// Whether the overlay is being computed.
+    pub fn overlay_busy(&self) -> bool {
+        self.worker.busy()
+    }
+}
