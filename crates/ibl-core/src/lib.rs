@@ -22,7 +22,9 @@ pub use fibonacci::fibonacci_normals;
 pub use frame::{EulerDegrees, FramePreset};
 pub use glam;
 pub use image::Image;
-pub use irradiance::{RowIrradiance, channel_means, irradiance_exact, valid_radiance};
+pub use irradiance::{
+    RowIrradiance, channel_means, irradiance_exact, irradiance_exact_with_progress, valid_radiance,
+};
 pub use latlong::LatLong;
 pub use metrics::IrradianceError;
 pub use rgb::Rgb;
