@@ -378,7 +378,7 @@ fn streamed(
             }
             // Rows every group has finished, reported by the group that completes them.
             let total = rows_done.fetch_add(1, Ordering::Relaxed) + 1;
-            if total % groups == 0 {
+            if total.is_multiple_of(groups) {
                 progress(total / groups, h);
             }
         }

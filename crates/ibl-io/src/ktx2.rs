@@ -144,7 +144,7 @@ fn key_values(kind: TextureKind) -> Vec<u8> {
         out.push(0);
         out.extend_from_slice(v.as_bytes());
         out.push(0);
-        while out.len() % 4 != 0 {
+        while !out.len().is_multiple_of(4) {
             out.push(0);
         }
     }
@@ -153,7 +153,7 @@ fn key_values(kind: TextureKind) -> Vec<u8> {
 
 fn lcm4(n: usize) -> usize {
     let mut m = n.max(1);
-    while m % 4 != 0 {
+    while !m.is_multiple_of(4) {
         m += n.max(1);
     }
     m

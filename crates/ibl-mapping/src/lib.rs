@@ -13,16 +13,30 @@
 //! * [`resample`](mod@resample): area-averaging resampling and rotation (rows in parallel,
 //!   deterministic).
 //! * [`power`](mod@power): `sum L dOmega` per channel.
+//! * [`prefilter`](mod@prefilter): engine-ready maps in one call: the GGX specular chain
+//!   ([`specular`] over a seamless [`cube_pyramid`], roughness per level from [`ggx`]), the
+//!   irradiance cube, SH and the split-sum table ([`dfg`]).
 
 pub mod cube;
+pub mod cube_pyramid;
+pub mod dfg;
 pub mod disc;
 pub mod fisheye;
+pub mod ggx;
 pub mod mapping;
 pub mod power;
+pub mod prefilter;
 mod projection;
 pub mod resample;
+pub mod specular;
 
 pub use cube::{CUBE_FACE_NAMES, join_cube_faces, split_cube_faces};
+pub use cube_pyramid::CubePyramid;
+pub use dfg::{Dfg, DfgLayout};
+pub use ggx::EngineTarget;
 pub use mapping::{CubeLayout, MAPPING_NAMES, Mapping, MappingError};
 pub use power::{power, try_power};
+pub use prefilter::{
+    DfgOptions, PrefilterOptions, Prefiltered, SpecularChain, SpecularOptions, prefilter,
+};
 pub use resample::{resample, rotate};
