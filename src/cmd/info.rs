@@ -19,9 +19,11 @@ Examples:
   ibl info assets/probes/esplanade.exr
   ibl info probe.hdr --json | jq .brightest
   ibl info ball.exr --mapping mirror-ball
+  ibl info env.ktx2                         # a KTX2/DDS cube: format, levels, faces
   ibl info probe.exr --frame blender        # brightest direction in Blender's Z-up axes")]
 pub struct InfoArgs {
-    /// The image to describe (.hdr, .exr, .pfm, .png, .jpg).
+    /// The image to describe (.hdr, .exr, .pfm, .png, .jpg; .ktx2 and .dds: level 0, a cube map
+    /// as its six faces side by side).
     pub file: PathBuf,
     /// Mapping of the image (default: guessed from its shape; 2:1 is lat-long, 1:1 angular).
     #[arg(long, value_name = "MAPPING")]
@@ -114,9 +116,11 @@ pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
         ))
     })?;
     let env = envmap_files::load(&args.file, mapping_arg)?;
+    // A KTX2/DDS cube map says it is one: its mapping is read, not guessed.
+    let cube_texture = env.format.is_texture() && env.details.contains("cube");
     let info = describe(
         &env,
-        mapping_arg.is_none(),
+        mapping_arg.is_none() && !cube_texture,
         frame,
         &args.file.display().to_string(),
     );

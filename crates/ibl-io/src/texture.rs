@@ -16,6 +16,7 @@
 //! by more than 2^9). R11G11B10 (read only) is the packed unsigned float of the same specs.
 
 use half::f16;
+use ibl_core::{Image, Rgb};
 
 /// The texel formats iblkit reads and writes in KTX2 and DDS files.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -311,10 +312,60 @@ impl Texture {
         Ok(())
     }
 
+    /// A cube map with mip levels from six faces per level (GL orientation, level 0 first).
+    pub fn from_cube_levels(levels: &[[Image<Rgb>; 6]]) -> Texture {
+        Texture {
+            kind: TextureKind::Cube,
+            channels: 3,
+            levels: levels
+                .iter()
+                .map(|faces| TextureLevel {
+                    width: faces[0].width(),
+                    height: faces[0].height(),
+                    faces: faces.iter().map(rgb_values).collect(),
+                })
+                .collect(),
+        }
+    }
+
+    /// A 2D texture with mip levels from one image per level (level 0 first).
+    pub fn from_image_levels(levels: &[Image<Rgb>]) -> Texture {
+        Texture {
+            kind: TextureKind::Flat,
+            channels: 3,
+            levels: levels
+                .iter()
+                .map(|img| TextureLevel {
+                    width: img.width(),
+                    height: img.height(),
+                    faces: vec![rgb_values(img)],
+                })
+                .collect(),
+        }
+    }
+
+    /// A one-level two-channel 2D texture of `width x height` `[r, g]` texels, row-major.
+    pub fn from_rg(width: usize, height: usize, texels: &[[f32; 2]]) -> Texture {
+        Texture {
+            kind: TextureKind::Flat,
+            channels: 2,
+            levels: vec![TextureLevel {
+                width,
+                height,
+                faces: vec![texels.iter().flatten().copied().collect()],
+            }],
+        }
+    }
+
     /// Width and height of level 0.
     pub fn size(&self) -> (usize, usize) {
         self.levels.first().map_or((0, 0), |l| (l.width, l.height))
     }
+}
+
+/// The `r, g, b` values of an image, row-major.
+fn rgb_values(img: &Image<Rgb>) -> Vec<f32> {
+    img.pixels().iter().flat_map(|p| [p.r, p.g, p.b]).collect()
 }
 
 #[cfg(test)]

@@ -55,9 +55,9 @@ pub fn smith_ggx_correlated(n_v: f64, n_l: f64, alpha: f64) -> f64 {
 pub enum EngineTarget {
     /// Filament (cmgen, `IndirectLight`): `m / (L - 1) = r (2 - r)`, so
     /// `r = 1 - sqrt(1 - m / (L - 1))`; levels down to 16 px faces (cmgen
-    /// `--ibl-min-lod-size`, default 16). Source: filament `shaders/src/light_indirect.fs`
-    /// (`perceptualRoughnessToLod`), `libs/ibl/src/CubemapIBL.cpp` / `filament/src/fg/...
-    /// IBLPrefilterContext.cpp` (`lodToPerceptualRoughness`).
+    /// `--ibl-min-lod-size`, default 16). Source: filament
+    /// `libs/iblprefilter/src/IBLPrefilterContext.cpp` (`lodToPerceptualRoughness`) and its
+    /// inverse in the shaders (`perceptualRoughnessToLod`).
     Filament,
     /// Khronos glTF-IBL-Sampler and glTF-Sample-Viewer: `r = m / (L - 1)`, `L = log2(S)` (the
     /// smallest level is 2 x 2). Source: glTF-IBL-Sampler `lib/source/lib.cpp`
@@ -65,7 +65,8 @@ pub enum EngineTarget {
     /// `_mipmapCount = floor(log2(resolution))`).
     Khronos,
     /// Bevy (`EnvironmentMapLight`): `m = r (L - 1)` with `L` the levels in the file
-    /// (`pbr/environment_map.wgsl`: `perceptual_roughness * f32(textureNumLevels(...) - 1)`);
+    /// (`crates/bevy_pbr/src/light_probe/environment_map.wgsl`:
+    /// `perceptual_roughness * f32(textureNumLevels(...) - 1)`);
     /// the chain is the full one down to 1 x 1. Bevy samples the cube at `(x, y, -z)`.
     Bevy,
     /// Unity (built-in and SRP): `m = 6 r (1.7 - 0.7 r)` (`UNITY_SPECCUBE_LOD_STEPS = 6`,
@@ -73,7 +74,7 @@ pub enum EngineTarget {
     /// `ShaderLibrary/ImageBasedLighting.hlsl` (`PerceptualRoughnessToMipmapLevel`,
     /// `MipmapLevelToPerceptualRoughness`).
     Unity,
-    /// three.js PMREM (`cube_uv_reflection_fragment.glsl`, `roughnessToMip`): a level of face
+    /// three.js PMREM (`cube_uv_reflection_fragment.glsl.js`, `roughnessToMip`): a level of face
     /// size `2^k` holds `r = 2^(-k/2) / 1.16` where that is under 0.21, else the piecewise-linear
     /// inverse (k = 4: 0.21, 3: 0.305, 2: 0.4); levels down to 16 px. three.js filters its own
     /// chain when it loads a map; this target reproduces the roughness it gives each face size.

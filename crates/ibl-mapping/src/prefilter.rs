@@ -99,6 +99,35 @@ pub struct Prefiltered {
     pub dfg: Option<Dfg>,
 }
 
+impl SpecularChain {
+    /// Every cube level resampled (energy-conservingly) to a horizontal cross of `face`-pixel
+    /// faces, left to right, level 0 first: a picture of the whole chain at one scale.
+    pub fn contact_sheet(&self, face: usize) -> Result<Image<Rgb>, MappingError> {
+        let cross = Mapping::Cube(CubeLayout::HorizontalCross);
+        let (cw, ch) = (4 * face.max(1), 3 * face.max(1));
+        let mut sheet = Image::filled(cw * self.cube.len().max(1), ch, Rgb::ZERO);
+        for (m, faces) in self.cube.iter().enumerate() {
+            let strip = crate::join_cube_faces(faces, CubeLayout::HorizontalStrip)?;
+            let strip_mapping = Mapping::Cube(CubeLayout::HorizontalStrip);
+            let cell = resample(
+                &strip,
+                strip_mapping,
+                cross,
+                cw,
+                ch,
+                glam::Mat3::IDENTITY,
+                &|_, _| {},
+            )?;
+            for y in 0..ch {
+                for (x, p) in cell.row(y).iter().enumerate() {
+                    *sheet.get_mut(m * cw + x, y) = *p;
+                }
+            }
+        }
+        Ok(sheet)
+    }
+}
+
 fn parameter(msg: String) -> MappingError {
     MappingError::Parameter(msg)
 }
