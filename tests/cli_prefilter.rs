@@ -63,7 +63,7 @@ fn every_output_loads_and_a_constant_probe_stays_constant() {
         .map(|v| v.as_f64().unwrap())
         .collect();
     assert_eq!(roughness, vec![0.0, 1.0 / 3.0, 2.0 / 3.0, 1.0]); // log2(16) = 4 levels
-    let spec = read_texture(&p("spec.ktx2").as_ref(), &Limits::default()).unwrap();
+    let spec = read_texture(p("spec.ktx2").as_ref(), &Limits::default()).unwrap();
     assert_eq!(spec.texture.kind, TextureKind::Cube);
     assert_eq!(spec.texture.levels.len(), 4);
     for level in &spec.texture.levels {
@@ -76,12 +76,12 @@ fn every_output_loads_and_a_constant_probe_stays_constant() {
             }
         }
     }
-    let ll = read_texture(&p("spec-ll.dds").as_ref(), &Limits::default()).unwrap();
+    let ll = read_texture(p("spec-ll.dds").as_ref(), &Limits::default()).unwrap();
     assert_eq!(
         (ll.texture.kind, ll.texture.size()),
         (TextureKind::Flat, (64, 32))
     );
-    let irr = read_texture(&p("irr.dds").as_ref(), &Limits::default()).unwrap();
+    let irr = read_texture(p("irr.dds").as_ref(), &Limits::default()).unwrap();
     assert_eq!(
         (irr.texture.kind, irr.texture.size()),
         (TextureKind::Cube, (4, 4))
@@ -91,7 +91,7 @@ fn every_output_loads_and_a_constant_probe_stays_constant() {
         // about 2e-4 (midpoint rule, `ibl-core`'s constant-environment test).
         assert!((v[1] - l.g).abs() < 1e-3 * l.g, "{v:?}");
     }
-    let dfg = read_texture(&p("dfg.ktx2").as_ref(), &Limits::default()).unwrap();
+    let dfg = read_texture(p("dfg.ktx2").as_ref(), &Limits::default()).unwrap();
     assert_eq!((dfg.texture.channels, dfg.texture.size()), (2, (8, 8)));
     let sh = ibl_io::read_sh_file(p("sh.json").as_ref(), ibl_io::ShFileFormat::Json).unwrap();
     assert_eq!(sh.bands, 3);

@@ -30,7 +30,10 @@ fn bench(c: &mut Criterion) {
             ..Default::default()
         };
         g.bench_function(format!("cube_256_full_chain_{}", target.name()), |b| {
-            b.iter(|| prefilter(black_box(&sky), Mapping::LatLong, &options, &|_, _| {}).unwrap())
+            b.iter(|| {
+                prefilter(black_box(&sky), Mapping::LatLong, &options, &|_, _| {})
+                    .expect("prefilters")
+            })
         });
     }
     let dfg = PrefilterOptions {
@@ -42,7 +45,9 @@ fn bench(c: &mut Criterion) {
         ..Default::default()
     };
     g.bench_function("dfg_128_1024_samples", |b| {
-        b.iter(|| prefilter(black_box(&sky), Mapping::LatLong, &dfg, &|_, _| {}).unwrap())
+        b.iter(|| {
+            prefilter(black_box(&sky), Mapping::LatLong, &dfg, &|_, _| {}).expect("prefilters")
+        })
     });
     g.finish();
 }
