@@ -1,6 +1,8 @@
 //! Maps errors to messages and exit codes: 2 when the input or the arguments are at fault (a
 //! corrupt file, an unknown mapping, an output that would overwrite an input), 1 for everything
-//! else (an internal failure, a full disk). Every message names the file it concerns.
+//! else (an internal failure, a full disk). The libraries' errors say which
+//! ([`ibl_pipeline::PipelineError::is_bad_input`]); argument errors are clap's (exit 2 in
+//! `main`). Every message names the file it concerns.
 
 use std::process::ExitCode;
 
@@ -9,24 +11,19 @@ pub const EXIT_BAD_INPUT: u8 = 2;
 /// Exit status for internal failures.
 pub const EXIT_INTERNAL: u8 = 1;
 
-/// A problem with the command line itself (a value the parser accepted but that makes no sense).
-#[derive(Debug, thiserror::Error)]
-#[error("{0}")]
-pub struct UsageError(pub String);
-
-/// Shorthand for returning a [`UsageError`].
-pub fn usage(msg: impl Into<String>) -> anyhow::Error {
-    UsageError(msg.into()).into()
-}
-
-/// Whether any error in the chain says the input was at fault.
+/// Whether the error says the input was at fault: the verdict of the outermost library error in
+/// the chain (anything else, e.g. failing to print, is internal).
 pub fn is_bad_input(err: &anyhow::Error) -> bool {
-    err.chain().any(|cause| {
-        if let Some(e) = cause.downcast_ref::<ibl_io::IoError>() {
-            return e.is_bad_input();
-        }
-        cause.is::<UsageError>() || cause.is::<ibl_mapping::MappingError>()
-    })
+    err.chain()
+        .find_map(|cause| {
+            if let Some(e) = cause.downcast_ref::<ibl_pipeline::PipelineError>() {
+                return Some(e.is_bad_input());
+            }
+            cause
+                .downcast_ref::<ibl_io::IoError>()
+                .map(ibl_io::IoError::is_bad_input)
+        })
+        .unwrap_or(false)
 }
 
 /// The error and its causes joined by `: `, leaving out a cause whose text the message already

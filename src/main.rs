@@ -1,12 +1,14 @@
 //! `ibl`: the iblkit command line tool.
 //!
-//! Each subcommand lives in `src/cmd/`. Errors are reported as `ibl: <file>: <problem>` on stderr;
-//! the exit code is 2 for bad input or arguments and 1 for internal failures (see `failure.rs`).
+//! Each subcommand lives in `src/cmd/`: it parses its arguments, fills the options of one
+//! `ibl-pipeline` job, runs it with progress bars, and prints the job's summary (text or JSON).
+//! Errors are reported as `ibl: <file>: <problem>` on stderr; the exit code is 2 for bad input or
+//! arguments and 1 for internal failures (see `failure.rs`).
 
 mod cmd;
-mod envmap_files;
 mod failure;
 mod progress;
+mod values;
 
 use std::process::ExitCode;
 

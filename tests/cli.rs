@@ -31,6 +31,8 @@ fn info_json_has_every_field_on_every_bundled_probe() {
                 .map(|x| x.as_f64().unwrap())
                 .collect();
             let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+            // The JSON direction is an f32 unit vector printed in full: unit to f32 rounding
+            // (1e-7); 1e-4.
             assert!(
                 (len - 1.0).abs() < 1e-4,
                 "{path}: brightest direction not unit: {d:?}"
@@ -118,6 +120,9 @@ fn convert_between_formats_and_cube_faces_round_trips() {
     };
     let (a, b) = (power(&probe("sunset.hdr")), power(&d("back.exr")));
     for c in 0..3 {
+        // A cube round trip resamples twice with area averaging that conserves energy to the
+        // sub-sample quadrature (the demo's round trips print their power change; a few hundredths
+        // of a per cent); 0.5 %.
         assert!(
             (a[c] - b[c]).abs() / a[c] < 0.005,
             "channel {c}: {} vs {}",
@@ -303,6 +308,9 @@ fn demo_writes_every_mapping_and_an_index() {
         for m in p["mappings"].as_array().unwrap() {
             assert!(out_dir.join(m["preview"].as_str().unwrap()).exists());
             if let Some(change) = m["round_trip_power_change_pct"].as_f64() {
+                // Round trips through every mapping keep the power to the resampler's quadrature
+                // (the demo prints them); 0.5 %, while a lost face or hemisphere would change it by
+                // 15 % or more.
                 assert!(
                     change.abs() < 0.5,
                     "{} {}: {change} %",
@@ -404,6 +412,8 @@ fn lights_writes_the_json_light_set_and_conserves_power() {
             .map(|l| l["irradiance"][c].as_f64().unwrap())
             .sum();
         let power = info["power"][c].as_f64().unwrap();
+        // Median cut's lights carry the probe's power per region in f64; the file and `info` print
+        // shortest round-trip decimals, so the sums agree to f64 rounding (1e-15); 1e-6 relative.
         assert!(
             (sum - power).abs() / power < 1e-6,
             "channel {c}: {sum} vs {power}"
@@ -425,6 +435,8 @@ fn lights_writes_the_json_light_set_and_conserves_power() {
     let b: serde_json::Value = serde_json::from_slice(&std::fs::read(&out_b).unwrap()).unwrap();
     let (d, db) = (&lights[3]["direction"], &b["lights"][3]["direction"]);
     let f = |x: &serde_json::Value| x.as_f64().unwrap();
+    // Blender's axes are a signed permutation of ours, exact in f64: the JSON round trip keeps the
+    // digits; 1e-12.
     assert!((f(&db[0]) - f(&d[0])).abs() < 1e-12);
     assert!((f(&db[1]) + f(&d[2])).abs() < 1e-12);
     assert!((f(&db[2]) - f(&d[1])).abs() < 1e-12);
@@ -482,6 +494,8 @@ fn irradiance_csv_is_the_ground_truth() {
     let a = k * std::f64::consts::PI * (3.0 - 5.0f64.sqrt());
     let r = (1.0 - y * y).sqrt();
     let row = &rows[123];
+    // CONVENTIONS section 5's Fibonacci formula in f64, printed with shortest round-trip digits:
+    // equal to a few ulps; 1e-12.
     assert!((row[0] - r * a.cos()).abs() < 1e-12 && (row[1] - y).abs() < 1e-12);
     assert!((row[2] - r * a.sin()).abs() < 1e-12);
     assert!(

@@ -274,6 +274,8 @@ fn merge_recovers_the_radiance_of_a_synthetic_bracket() {
         .map(|t| t.as_f64().unwrap())
         .collect();
     for (t, want) in times.iter().zip(TIMES) {
+        // Fractions parsed to f64 and printed with shortest round-trip digits: exact to an ulp;
+        // 1e-12 relative.
         assert!((t - want).abs() < 1e-12 * want, "{t} vs {want}");
     }
     let outputs: Vec<&str> = v["outputs"]
@@ -620,6 +622,8 @@ fn ball_finds_the_circle_and_unwraps_it() {
     ];
     eprintln!("ball found at {found:?}, truth {truth:?}");
     for (f, t) in found.iter().zip(truth) {
+        // The ball is found to within a pixel: its rim is located by an edge search on a 512-pixel
+        // photo (crates/ibl-capture/tests/ball.rs checks the same bound on its own balls); 1 pixel.
         assert!((f - t).abs() < 1.0, "found {found:?}, truth {truth:?}");
     }
     for name in ["probe.exr", "probe.png", "probe-reliability-0.png"] {

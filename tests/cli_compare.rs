@@ -47,12 +47,15 @@ fn metrics_match_the_closed_form() {
     assert!((num("mean_abs") - delta).abs() < 1e-12);
     assert!((num("max_abs") - delta).abs() < 1e-12);
     let rel = delta * delta / (0.25 + 0.01);
+    // delta = 0.125 and b = 0.5 are exact in binary: the relative MSE is one f64 division of exact
+    // values; 1e-12.
     assert!(
         (num("relative_mse") - rel).abs() < 1e-12,
         "{}",
         num("relative_mse")
     );
     assert_eq!(num("relative_mse_epsilon"), 0.01);
+    // PSNR = 10 log10(0.25 / delta^2) through one f64 log10: rounding of order 1e-15; 1e-9.
     assert!((num("psnr_db") - 10.0 * (0.25f64 / (delta * delta)).log10()).abs() < 1e-9);
     assert_eq!(v["pixels"], 32 * 24);
     assert_eq!(v["flip"]["range"], "hdr");
@@ -113,6 +116,7 @@ fn error_images_are_written() {
     assert!(o.status.success(), "{}", stderr(&o));
     let map = ibl_io::read_image(&exr).unwrap().image;
     let want = 0.125f32 * 0.125 / 0.26;
+    // The raw relMSE map in f32 (EXR float): 0.125^2 / 0.26 to f32 rounding (6e-8 relative); 1e-6.
     assert!(
         map.pixels()
             .iter()
@@ -131,6 +135,7 @@ fn error_images_are_written() {
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let map = ibl_io::read_image(&abs).unwrap().image;
+    // |a - b| = 0.125 exactly in f32 and EXR float; 1e-7 allows one rounding.
     assert!(map.pixels().iter().all(|p| (p.r - 0.125).abs() < 1e-7));
 }
 
@@ -181,7 +186,11 @@ fn ldr_pictures_use_ldr_flip() {
     assert_eq!(v["flip"]["range"], "ldr");
     assert!(v["flip"]["exposures"].as_array().unwrap().is_empty());
     let flip = v["flip"]["mean"].as_f64().unwrap();
+    // Black against white is FLIP's largest difference: the mean is 1 but for the filters' edge
+    // handling on a 16 x 16 image; above 0.95.
     assert!(flip > 0.95 && flip <= 1.0, "black against white: {flip}");
+    // RMSE of 0 against 1 (8-bit codes 0 and 255 decode exactly to 0 and 1): 1 to f32 rounding;
+    // 1e-6.
     assert!((v["rmse"].as_f64().unwrap() - 1.0).abs() < 1e-6);
 }
 

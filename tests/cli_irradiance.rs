@@ -67,6 +67,9 @@ fn sh_maps_state_their_error_and_converge() {
         last = mean;
         assert_eq!(v["bands"], bands.parse::<u64>().unwrap());
     }
+    // SH21 irradiance on the sky probe: the 18 shared probes average 0.083 % mean error at 21 bands
+    // (ARCHITECTURE.md), the sky's compact sun is the hard case; 0.4 % still fails a broken
+    // projection (SH3 is about 3 %).
     assert!(last < 0.4, "21 bands: {last}");
     // The exact method has no error to state.
     let out = dir.path().join("exact.exr");

@@ -488,7 +488,6 @@ fn outputs_naming_the_input_are_refused_and_the_input_kept() {
 
 #[test]
 fn hybrid_lights_carry_an_sh_ambient_in_json() {
-    use ibl_core::glam::DVec3;
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("hybrid.json");
     let sky = probe("sky.exr");
@@ -522,16 +521,16 @@ fn hybrid_lights_carry_an_sh_ambient_in_json() {
         .map(|n| {
             let a = sh.irradiance(*n);
             let mut e = a;
-            for l in &file.lights {
-                let c = n.dot(DVec3::from_array(l.direction)).max(0.0);
-                for (v, i) in e.iter_mut().zip(l.irradiance) {
+            for l in &file.set.lights {
+                let c = n.dot(l.direction).max(0.0);
+                for (v, i) in e.iter_mut().zip(l.irradiance.to_array()) {
                     *v += i * c;
                 }
             }
             e
         })
         .collect();
-    let err = ibl_core::IrradianceError::between(&truth, &approx);
+    let err = ibl_metrics::IrradianceError::between(&truth, &approx);
     assert!(err.mean_err_pct < 3.0, "{err:?}");
     // Only JSON has a place for the ambient.
     let gltf = dir.path().join("h.gltf");

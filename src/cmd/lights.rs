@@ -1,29 +1,16 @@
 //! `ibl lights`: approximate a lat-long probe by N directional lights with any extraction method
-//! (Madsen & Laursen 2006) and write them as the JSON light set of CONVENTIONS section 7, glTF 2.0
-//! (`KHR_lights_punctual`, `.gltf`/`.glb`), a Mitsuba 3 scene or a pbrt-v4 fragment
-//! (`ibl_io::light_export`), directions in any frame preset; optionally a picture of the regions
-//! and lights on the tone-mapped probe (`ibl_eval::overlay`, the paper's Figure 3).
-//!
-//! Everything is checked before the probe is read (flags, output extensions, outputs naming an
-//! input), so a mistake costs no extraction time; every file is written atomically.
+//! and write them as JSON, glTF, Mitsuba 3 or pbrt-v4 (`ibl_pipeline::lights`).
 
-use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
+use std::path::PathBuf;
 
 use clap::{ArgGroup, Args, ValueEnum};
 use ibl_core::FramePreset;
-use ibl_core::rgb::Rgb64;
-use ibl_extract::{ExtractOptions, LightSet, Method};
-use ibl_io::LightFormat;
-use ibl_io::light_file::{
-    AmbientRecord, LIGHTS_FORMAT, LightRecord, LightsFile, MethodRef, ProbeRef, RegionRecord,
-};
-use ibl_mapping::Mapping;
+use ibl_extract::ExtractOptions;
+use ibl_light::{LightSet, Method};
+use ibl_pipeline::lights::{LightsOptions, lights};
 
-use crate::cmd::convert::parse_frame;
-use crate::envmap_files::{self, MappingArg};
-use crate::failure::usage;
+use crate::progress::Bars;
+use crate::values;
 
 /// Extraction methods, as named on the command line (the same names as [`Method::name`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -96,8 +83,8 @@ pub struct LightsArgs {
     #[arg(short = 'o', long, value_name = "FILE")]
     pub output: Vec<PathBuf>,
     /// Frame of the written directions: gltf (ours), paper, threejs, blender.
-    #[arg(long, default_value = "gltf", value_name = "PRESET")]
-    pub frame: String,
+    #[arg(long, default_value = "gltf", value_name = "PRESET", value_parser = values::frame)]
+    pub frame: FramePreset,
     /// glTF only: lux per unit of a light's luminance Y(I), I = L A. The default 1 reads the
     /// probe's values as cd/m^2; a light's glTF intensity is LUX x max(I), its colour I / max(I).
     #[arg(long, default_value_t = 1.0, value_name = "LUX")]
@@ -116,253 +103,40 @@ pub struct LightsArgs {
     pub json: bool,
 }
 
-/// An output to write and its format.
-struct Output<'a> {
-    path: &'a Path,
-    format: LightFormat,
-}
-
-/// The usage error for an `-n` the method cannot make.
-fn count_error(method: Method, n: usize) -> anyhow::Error {
-    match method {
-        Method::MedianCut => usage(format!(
-            "-n {n}: median cut makes a power of two lights (1, 2, 4, ... up to {}); use \
-             --method adaptive-median-cut (or any other method) for other counts",
-            1u64 << ibl_extract::median_cut::MAX_SPLITS
-        )),
-        _ => usage(format!("-n {n}: {method} needs at least one light")),
-    }
-}
-
-/// Checks the flags and the output paths, before any work.
-fn check_args(args: &LightsArgs) -> anyhow::Result<Vec<Output<'_>>> {
-    if !(args.lux_per_unit.is_finite() && args.lux_per_unit > 0.0) {
-        return Err(usage(format!(
-            "--lux-per-unit must be a finite positive number (got {})",
-            args.lux_per_unit
-        )));
-    }
-    let method = args.method.method();
-    if !method.accepts(args.count) {
-        return Err(count_error(method, args.count));
-    }
-    let outputs = args
-        .output
-        .iter()
-        .map(|path| {
-            let format = LightFormat::from_path(path).ok_or_else(|| {
-                usage(format!(
-                    "{}: unknown light-set format (expected {})",
-                    path.display(),
-                    LightFormat::EXPECTED
-                ))
-            })?;
-            Ok(Output { path, format })
-        })
-        .collect::<anyhow::Result<Vec<_>>>()?;
-    if let Some(bands) = args.ambient_sh {
-        if bands == 0 || bands > ibl_sh::MAX_BANDS {
-            return Err(usage(format!(
-                "--ambient-sh must be between 1 and {}",
-                ibl_sh::MAX_BANDS
-            )));
-        }
-        if let Some(o) = outputs.iter().find(|o| o.format != LightFormat::Json) {
-            return Err(usage(format!(
-                "{}: {} has no place for an SH ambient; write the hybrid to a .json file \
-                 (and the probe's SH with `ibl sh --format ...`)",
-                o.path.display(),
-                o.format.name()
-            )));
-        }
-    }
-    if let Some(overlay) = &args.overlay
-        && !matches!(
-            ibl_io::ImageFormat::from_path(overlay),
-            Some(ibl_io::ImageFormat::Png)
-        )
-    {
-        return Err(usage(format!(
-            "{}: the overlay is written as .png",
-            overlay.display()
-        )));
-    }
-    let all: Vec<&Path> = args
-        .output
-        .iter()
-        .chain(&args.overlay)
-        .map(PathBuf::as_path)
-        .collect();
-    for (i, path) in all.iter().enumerate() {
-        if all[..i].contains(path) {
-            return Err(usage(format!(
-                "{}: named twice as an output",
-                path.display()
-            )));
-        }
-        ibl_io::ensure_output_is_not_input(path, &[args.probe.as_path()])?;
-    }
-    Ok(outputs)
-}
-
-/// A method's parameters as JSON numbers, whole values as integers (`"splits": 4`).
-fn parameters_json(parameters: &BTreeMap<String, f64>) -> serde_json::Value {
-    const EXACT: f64 = 9_007_199_254_740_992.0; // 2^53
-    serde_json::Value::Object(
-        parameters
-            .iter()
-            .map(|(k, &v)| {
-                let value = if v.fract() == 0.0 && v.abs() <= EXACT {
-                    serde_json::json!(v as i64)
-                } else {
-                    serde_json::json!(v)
-                };
-                (k.clone(), value)
-            })
-            .collect(),
-    )
-}
-
 /// Runs `ibl lights`.
 pub fn run(args: &LightsArgs) -> anyhow::Result<()> {
-    let frame = parse_frame(&args.frame)?;
-    let outputs = check_args(args)?;
-    let method = args.method.method();
-    if frame != FramePreset::Gltf {
-        for o in &outputs {
-            if matches!(o.format, LightFormat::Gltf | LightFormat::Glb) {
-                eprintln!(
-                    "note: {}: glTF is defined in the gltf frame; writing the directions in the \
-                     {} preset's axes as asked",
-                    o.path.display(),
-                    frame.name()
-                );
-            }
-        }
-    }
-
-    let env = envmap_files::load(&args.probe, Some(MappingArg::Single(Mapping::LatLong)))?;
-    crate::cmd::convert::report_clamped(&env);
-    let spinner = indicatif::ProgressBar::new_spinner();
-    spinner.set_message(format!("{method}: {} lights", args.count));
-    spinner.enable_steady_tick(Duration::from_millis(120));
-    let start = Instant::now();
-    let extraction = ibl_extract::extract(
-        &env.image,
-        method,
-        args.count,
-        &ExtractOptions { seed: args.seed },
-    );
-    let seconds = start.elapsed().as_secs_f64();
-    spinner.finish_and_clear();
-    let extraction =
-        extraction.map_err(|e| usage(format!("{}: {method}: {e}", args.probe.display())))?;
-    let set = &extraction.set;
-    eprintln!("{method}: {} lights in {seconds:.2} s", set.lights.len());
-    if set.lights.len() != args.count {
-        // Median cut, for one, cannot cut a region of one pixel.
-        eprintln!(
-            "note: {method} made {} lights, not the {} asked",
-            set.lights.len(),
-            args.count
-        );
-    }
-
-    let m = frame.preset_from_world().as_dmat3();
-    let ambient = match args.ambient_sh {
-        Some(bands) => {
-            let hybrid = ibl_extract::Hybrid::from_probe(
-                &env.image,
-                set.clone(),
-                bands,
-                ibl_sh::Window::None,
-            )
-            .map_err(|e| usage(format!("{}: {e}", args.probe.display())))?;
-            Some(AmbientRecord {
-                convention: ibl_io::sh_file::SH_CONVENTION.to_string(),
-                bands,
-                radiance: hybrid.ambient.transformed(m).coefficients().to_vec(),
-            })
-        }
-        None => None,
+    let options = LightsOptions {
+        probe: args.probe.clone(),
+        count: args.count,
+        method: args.method.method(),
+        seed: args.seed,
+        outputs: args.output.clone(),
+        frame: args.frame,
+        lux_per_unit: args.lux_per_unit,
+        overlay: args.overlay.clone(),
+        ambient_sh: args.ambient_sh,
     };
-    let file = LightsFile {
-        format: LIGHTS_FORMAT.to_string(),
-        probe: ProbeRef {
-            path: args.probe.display().to_string(),
-            width: env.image.width(),
-            height: env.image.height(),
-            sha256: ibl_io::light_file::sha256_file(&args.probe)?,
-        },
-        frame: frame.name().to_string(),
-        method: MethodRef {
-            name: set.method.clone(),
-            parameters: parameters_json(&extraction.parameters),
-        },
-        lights: set
-            .lights
-            .iter()
-            .map(|l| LightRecord {
-                direction: (m * l.dir()).to_array(),
-                radiance: l.radiance.to_array(),
-                solid_angle: l.solid_angle_sr,
-                irradiance: l.irradiance,
-                region: l.region.map(|r| RegionRecord {
-                    x0: r.x0,
-                    y0: r.y0,
-                    x1: r.x1,
-                    y1: r.y1,
-                }),
-            })
-            .collect(),
-        ambient,
-    };
-    for o in &outputs {
-        ibl_io::write_light_file(o.path, &file, args.lux_per_unit)?;
-        eprintln!(
-            "wrote {} ({}, {} lights, {} frame)",
-            o.path.display(),
-            o.format.name(),
-            set.lights.len(),
-            frame.name()
-        );
-    }
-    if let Some(path) = &args.overlay {
-        let picture = ibl_eval::overlay::draw_overlay(
-            &env.image,
-            set,
-            &ibl_eval::overlay::OverlayOptions::default(),
-        );
-        let png = ibl_io::ldr::encode_png(&picture).map_err(|e| e.with_path(path))?;
-        ibl_io::write_atomically(path, &png)?;
-        eprintln!(
-            "wrote {} ({} x {} overlay)",
-            path.display(),
-            picture.width(),
-            picture.height()
-        );
-    }
-
-    let probe_power = ibl_mapping::power(&env.image, Mapping::LatLong);
+    let result = lights(&options, &Bars::default())?;
+    let set = &result.set;
     if args.json {
         let summary = serde_json::json!({
             "probe": args.probe.display().to_string(),
-            "method": method.name(),
+            "method": options.method.name(),
             "n": set.lights.len(),
             "requested": args.count,
             "seed": args.seed,
-            "frame": frame.name(),
-            "seconds": seconds,
+            "frame": args.frame.name(),
+            "seconds": result.seconds,
             "total_power": set.total_power(),
-            "probe_power": probe_power,
-            "parameters": file.method.parameters,
+            "probe_power": result.probe_power,
+            "parameters": result.parameters,
             "ambient_sh_bands": args.ambient_sh,
             "outputs": args.output.iter().map(|p| p.display().to_string()).collect::<Vec<_>>(),
             "overlay": args.overlay.as_ref().map(|p| p.display().to_string()),
         });
         println!("{summary:#}");
     } else {
-        print_summary(set, &probe_power);
+        print_summary(set, &result.probe_power);
     }
     Ok(())
 }
@@ -372,7 +146,7 @@ fn print_summary(set: &LightSet, probe_power: &[f64; 3]) {
     println!(
         "{} lights by {}; power {:.5e} {:.5e} {:.5e} (probe {:.5e} {:.5e} {:.5e})",
         set.lights.len(),
-        set.method,
+        set.provenance.extraction.name(),
         p[0],
         p[1],
         p[2],
@@ -381,10 +155,7 @@ fn print_summary(set: &LightSet, probe_power: &[f64; 3]) {
         probe_power[2]
     );
     let mut order: Vec<usize> = (0..set.lights.len()).collect();
-    let lum = |i: &usize| {
-        let [r, g, b] = set.lights[*i].irradiance;
-        Rgb64 { r, g, b }.luminance()
-    };
+    let lum = |i: &usize| set.lights[*i].irradiance.luminance();
     order.sort_by(|a, b| lum(b).total_cmp(&lum(a)));
     println!("strongest lights (world direction, solid angle sr, irradiance I = L A):");
     for i in order.iter().take(5) {
@@ -415,18 +186,5 @@ mod tests {
             let name = arg.to_possible_value().map(|v| v.get_name().to_string());
             assert_eq!(name.as_deref(), Some(method.name()));
         }
-    }
-
-    #[test]
-    fn whole_parameters_are_integers() {
-        let p = BTreeMap::from([
-            ("splits".to_string(), 4.0),
-            ("tolerance".to_string(), 0.25),
-            ("converged".to_string(), 1.0),
-        ]);
-        assert_eq!(
-            parameters_json(&p).to_string(),
-            r#"{"converged":1,"splits":4,"tolerance":0.25}"#
-        );
     }
 }

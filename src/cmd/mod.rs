@@ -4,7 +4,6 @@ pub mod capture;
 pub mod compare;
 pub mod convert;
 pub mod demo;
-pub mod demo_render;
 pub mod eval;
 pub mod info;
 pub mod irradiance;

@@ -1,11 +1,10 @@
-//! `ibl preview`: an 8-bit sRGB picture of an HDR image, with exposure in stops and a tone curve.
+//! `ibl preview`: an 8-bit sRGB picture of an HDR image, with exposure in stops and a tone curve
+//! (`ibl_pipeline::preview`).
 
 use std::path::PathBuf;
 
 use clap::{Args, ValueEnum};
-use ibl_io::{Display, ToneCurve, WriteOptions};
-
-use crate::failure::usage;
+use ibl_core::tonemap::ToneCurve;
 
 /// A tone curve as named on the command line.
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -60,36 +59,11 @@ pub struct PreviewArgs {
 
 /// Runs `ibl preview`.
 pub fn run(args: &PreviewArgs) -> anyhow::Result<()> {
-    if let Some(e) = args.exposure
-        && !e.is_finite()
-    {
-        return Err(usage("--exposure must be a finite number of stops"));
-    }
-    if !matches!(
-        ibl_io::ImageFormat::from_path(&args.output),
-        Some(ibl_io::ImageFormat::Png | ibl_io::ImageFormat::Jpeg)
-    ) {
-        return Err(usage(format!(
-            "{}: a preview is written as .png or .jpg",
-            args.output.display()
-        )));
-    }
-    ibl_io::ensure_output_is_not_input(&args.output, &[args.input.as_path()])?;
-    let loaded = ibl_io::read_image(&args.input)?;
-    let stops = args
-        .exposure
-        .unwrap_or_else(|| ibl_io::tonemap::auto_exposure_stops(&loaded.image));
-    let display = Display {
-        exposure_stops: stops,
-        curve: args.tonemap.into(),
-    };
-    ibl_io::write_image(
+    let stops = ibl_pipeline::preview::preview(
+        &args.input,
         &args.output,
-        &loaded.image,
-        &WriteOptions {
-            display,
-            ..Default::default()
-        },
+        args.exposure,
+        args.tonemap.into(),
     )?;
     eprintln!(
         "wrote {} (exposure {stops:+.2} stops, {:?})",

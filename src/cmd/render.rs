@@ -1,25 +1,17 @@
 //! `ibl render`: virtual objects lit by a light probe, composited into the probe panorama or a
-//! photograph by differential rendering (`ibl-render`), in one of three lighting modes: the
-//! path-traced reference, N directional lights with shadows, or lights plus an occluded SH ambient.
-//! Writes the composite as EXR plus a tone-mapped PNG beside it, and on request the layers (with
-//! and without the objects, object coverage).
+//! photograph by differential rendering, in the reference, lights or hybrid mode
+//! (`ibl_pipeline::render`). Writes the composite as EXR plus a tone-mapped PNG beside it, and on
+//! request the layers (with and without the objects, object coverage).
 
-use std::path::{Path, PathBuf};
-use std::time::Instant;
+use std::path::PathBuf;
 
-use anyhow::Context as _;
 use clap::{Args, ValueEnum};
-use ibl_core::glam::DVec3;
-use ibl_core::{FramePreset, Image, Rgb};
-use ibl_extract::{Light, LightSet};
-use ibl_io::{Display, WriteOptions};
-use ibl_render::lighting::LightingPlan;
-use ibl_render::{RenderOutput, RenderSettings};
+use ibl_light::LightSource;
+use ibl_pipeline::render::{Layers, RenderJob, View, render_scene};
 use ibl_scene::{RenderMode, ShadowKind};
-use serde::Serialize;
 
-use crate::failure::usage;
-use crate::progress;
+use crate::progress::Bars;
+use crate::values;
 
 /// Lighting modes on the command line.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -80,8 +72,8 @@ pub struct RenderArgs {
     pub lights: Option<PathBuf>,
     /// Extraction method for lights/hybrid (median-cut, adaptive-median-cut, lightgen,
     /// variance-minimization, irradiance-optimization, sun).
-    #[arg(long, value_name = "METHOD")]
-    pub method: Option<String>,
+    #[arg(long, value_name = "METHOD", value_parser = values::light_source)]
+    pub method: Option<LightSource>,
     /// Number of lights to extract.
     #[arg(short = 'n', long = "n", value_name = "N")]
     pub n: Option<usize>,
@@ -112,280 +104,53 @@ pub struct RenderArgs {
     pub json: bool,
 }
 
-/// What `--json` prints.
-#[derive(Serialize)]
-struct Summary {
-    scene: String,
-    mode: &'static str,
-    lights: Option<LightsSummary>,
-    width: u32,
-    height: u32,
-    spp: u32,
-    bounces: u32,
-    seed: u64,
-    seconds_lighting: f64,
-    seconds_render: f64,
-    rays: u64,
-    rays_per_second: f64,
-    paths: u64,
-    paths_without_objects: u64,
-    object_coverage: f64,
-    real_triangles: usize,
-    virtual_triangles: usize,
-    outputs: Vec<String>,
-}
-
-#[derive(Serialize)]
-struct LightsSummary {
-    source: String,
-    count: usize,
-    shadows: &'static str,
-}
-
 /// Runs `ibl render`.
 pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
-    let loaded = ibl_io::read_scene(&args.scene)?;
-    let mut inputs: Vec<&Path> = loaded.inputs.iter().map(PathBuf::as_path).collect();
-    if let Some(l) = &args.lights {
-        inputs.push(l);
-    }
-    let outputs = output_paths(&args.output, args.layers);
-    for out in &outputs {
-        // Refuse an unwritable format now, not after the render.
-        if ibl_io::ImageFormat::from_path(out).is_none() {
-            return Err(usage(format!(
-                "{}: unknown output format (use .exr, .hdr, .pfm, .png or .jpg)",
-                out.display()
-            )));
-        }
-        ibl_io::ensure_output_is_not_input(out, &inputs)?;
-    }
-    let mut loaded = loaded;
-    if args.panorama {
-        if !matches!(loaded.scene.background, ibl_scene::Background::Panorama) {
-            return Err(usage(format!(
-                "{}: --panorama needs a panorama background (this scene has a photograph)",
-                args.scene.display()
-            )));
-        }
-        loaded.scene.camera = ibl_scene::Camera::Panorama {
-            position: loaded.scene.probe.position,
-            world_from_probe: loaded.scene.probe.world_from_probe,
-        };
-    }
-    let scene = &loaded.scene;
-    let mut plan = LightingPlan::from_scene(scene);
-    if let Some(m) = args.mode {
-        plan.mode = m.into();
-    }
-    if let Some(m) = &args.method {
-        plan.method = m.clone();
-    }
-    if let Some(n) = args.n {
-        plan.lights = n;
-    }
-    if let Some(s) = args.shadows {
-        plan.shadows = match s {
+    let job = RenderJob {
+        scene: args.scene.clone(),
+        output: args.output.clone(),
+        mode: args.mode.map(RenderMode::from),
+        lights_file: args.lights.clone(),
+        method: args.method,
+        lights: args.n,
+        shadows: args.shadows.map(|s| match s {
             ShadowArg::Hard => ShadowKind::Hard,
             ShadowArg::Soft => ShadowKind::Soft,
-        };
-    }
-    if let Some(seed) = args.seed {
-        plan.seed = seed;
-    }
-    let lights_file = args.lights.clone().or(loaded.lights_path.clone());
-    if let Some(path) = &lights_file {
-        // Light files hold the probe file's units: apply the scene's radiance scale.
-        let scale = f64::from(loaded.description.probe.radiance_scale);
-        // A light file named by the scene: say which scene and field named it.
-        let mut set = read_light_set(path).map_err(|e| match args.lights {
-            Some(_) => e,
-            None => e.context(format!("{}: lighting.lights_file", args.scene.display())),
-        })?;
-        for light in &mut set.lights {
-            light.irradiance = light.irradiance.map(|c| c * scale);
-            light.radiance *= scale as f32;
-        }
-        plan.given = Some(set);
-    }
-    let settings = RenderSettings {
-        composite: scene.render.composite,
-        width: args.width.or(scene.render.width),
-        spp: args.spp.unwrap_or(scene.render.spp),
-        bounces: args.bounces.unwrap_or(scene.render.bounces),
-        seed: args.seed.unwrap_or(scene.render.seed),
-    };
-    check_settings(&settings)?;
-
-    let started = Instant::now();
-    let (lighting, set) = plan
-        .build(scene)
-        .map_err(|e| usage(format!("{}: lighting: {e}", args.scene.display())))?;
-    let seconds_lighting = started.elapsed().as_secs_f64();
-
-    let bar = progress::bar("rendering", 1);
-    let started = Instant::now();
-    let output = ibl_render::render(scene, &lighting, &settings, &progress::rows_callback(&bar))
-        .map_err(|e| usage(format!("{}: {e}", args.scene.display())))?;
-    bar.finish_and_clear();
-    let seconds_render = started.elapsed().as_secs_f64();
-
-    write_outputs(&output, &outputs)?;
-
-    let stats = output.stats;
-    let summary = Summary {
-        scene: args.scene.display().to_string(),
-        mode: plan.mode.name(),
-        lights: set.as_ref().map(|s| LightsSummary {
-            source: lights_file.as_ref().map_or_else(
-                || format!("{} (extracted)", plan.method),
-                |p| p.display().to_string(),
-            ),
-            count: s.lights.len(),
-            shadows: plan.shadows.name(),
         }),
-        width: stats.width,
-        height: stats.height,
-        spp: stats.spp,
-        bounces: settings.bounces,
-        seed: settings.seed,
-        seconds_lighting,
-        seconds_render,
-        rays: stats.rays,
-        rays_per_second: stats.rays as f64 / seconds_render.max(1e-9),
-        paths: stats.paths,
-        paths_without_objects: stats.paths_without_objects,
-        object_coverage: stats.object_coverage,
-        real_triangles: scene.real.triangle_count(),
-        virtual_triangles: scene.virtual_objects.triangle_count(),
-        outputs: outputs.iter().map(|p| p.display().to_string()).collect(),
+        spp: args.spp,
+        width: args.width,
+        bounces: args.bounces,
+        seed: args.seed,
+        view: if args.panorama {
+            View::Panorama
+        } else {
+            View::SceneCamera
+        },
+        layers: if args.layers {
+            Layers::All
+        } else {
+            Layers::Composite
+        },
     };
+    let summary = render_scene(&job, &Bars::default())?;
     if args.json {
         println!("{}", serde_json::to_string_pretty(&summary)?);
     } else {
         println!(
             "{}: {} x {}, {} spp, {} mode{}: {:.2} s, {:.1} M rays/s; wrote {}",
-            args.scene.display(),
-            stats.width,
-            stats.height,
-            stats.spp,
-            plan.mode.name(),
+            summary.scene,
+            summary.width,
+            summary.height,
+            summary.spp,
+            summary.mode,
             summary.lights.as_ref().map_or(String::new(), |l| format!(
                 " ({} lights, {} shadows)",
                 l.count, l.shadows
             )),
-            seconds_render,
+            summary.seconds_render,
             summary.rays_per_second / 1e6,
             summary.outputs.join(", ")
         );
     }
     Ok(())
-}
-
-fn check_settings(s: &RenderSettings) -> anyhow::Result<()> {
-    use ibl_scene::description::{MAX_BOUNCES, MAX_SPP, MAX_WIDTH};
-    if !(1..=MAX_SPP).contains(&s.spp) {
-        return Err(usage(format!("--spp {} is not in 1..={MAX_SPP}", s.spp)));
-    }
-    if !(1..=MAX_BOUNCES).contains(&s.bounces) {
-        return Err(usage(format!(
-            "--bounces {} is not in 1..={MAX_BOUNCES}",
-            s.bounces
-        )));
-    }
-    if let Some(w) = s.width
-        && !(2..=MAX_WIDTH).contains(&w)
-    {
-        return Err(usage(format!("--width {w} is not in 2..={MAX_WIDTH}")));
-    }
-    Ok(())
-}
-
-/// The composite, its PNG preview, and the layers: `OUT`, `OUT.png`, `OUT-with.EXT`, ...
-fn output_paths(output: &Path, layers: bool) -> Vec<PathBuf> {
-    let mut paths = vec![output.to_path_buf(), output.with_extension("png")];
-    if layers {
-        let ext = output
-            .extension()
-            .map_or("exr".to_string(), |e| e.to_string_lossy().into_owned());
-        let stem = output
-            .file_stem()
-            .map_or("render".to_string(), |s| s.to_string_lossy().into_owned());
-        for layer in ["with", "without"] {
-            paths.push(output.with_file_name(format!("{stem}-{layer}.{ext}")));
-            paths.push(output.with_file_name(format!("{stem}-{layer}.png")));
-        }
-        paths.push(output.with_file_name(format!("{stem}-alpha.png")));
-    }
-    paths
-}
-
-/// Writes the images named by [`output_paths`], in its order.
-fn write_outputs(output: &RenderOutput, paths: &[PathBuf]) -> anyhow::Result<()> {
-    let display = WriteOptions {
-        display: Display {
-            exposure_stops: ibl_io::tonemap::auto_exposure_stops(&output.background),
-            ..Display::default()
-        },
-        ..WriteOptions::default()
-    };
-    let alpha: Image<Rgb> = output.object_coverage.map(|&a| Rgb::splat(a));
-    let plain = WriteOptions::default();
-    let images: Vec<(&Image<Rgb>, &WriteOptions)> = vec![
-        (&output.composite, &display),
-        (&output.composite, &display),
-        (&output.with_objects, &display),
-        (&output.with_objects, &display),
-        (&output.without_objects, &display),
-        (&output.without_objects, &display),
-        (&alpha, &plain),
-    ];
-    for (path, (image, options)) in paths.iter().zip(images) {
-        ibl_io::write_image(path, image, options)?;
-    }
-    Ok(())
-}
-
-/// Reads an `ibl lights` JSON file as a light set in iblkit's frame (the probe's frame).
-pub fn read_light_set(path: &Path) -> anyhow::Result<LightSet> {
-    let file = ibl_io::light_file::read_lights_file(path)?;
-    let preset = FramePreset::from_name(&file.frame).ok_or_else(|| {
-        usage(format!(
-            "{}: unknown frame '{}'",
-            path.display(),
-            file.frame
-        ))
-    })?;
-    let world_from_preset = preset.world_from_preset().as_dmat3();
-    let lights = file
-        .lights
-        .iter()
-        .enumerate()
-        .map(|(i, l)| {
-            let d = world_from_preset * DVec3::from_array(l.direction);
-            let ok = d.is_finite()
-                && (d.length() - 1.0).abs() < 1e-3
-                && l.irradiance.iter().all(|c| c.is_finite() && *c >= 0.0)
-                && l.solid_angle.is_finite()
-                && l.solid_angle >= 0.0;
-            if !ok {
-                return Err(usage(format!(
-                    "{}: light {i}: direction must be a unit vector and irradiance and solid angle finite and non-negative",
-                    path.display()
-                )));
-            }
-            Ok(Light {
-                direction: d.normalize().to_array(),
-                radiance: Rgb::from_array(l.radiance),
-                solid_angle_sr: l.solid_angle,
-                irradiance: l.irradiance,
-                region: None,
-            })
-        })
-        .collect::<anyhow::Result<Vec<Light>>>()
-        .with_context(|| format!("reading lights from {}", path.display()))?;
-    Ok(LightSet {
-        method: file.method.name.clone(),
-        lights,
-    })
 }

@@ -92,20 +92,9 @@ fn occlude(img: &mut Image<Rgb>, c: &Circle) {
 
 /// Relative mean absolute error of luminance, solid-angle weighted, over the lat-long texels
 /// where `mask` holds: `sum |Y_a - Y_b| dOmega / sum Y_b dOmega`.
-fn relative_mae(a: &Image<Rgb>, b: &Image<Rgb>, mask: impl Fn(usize, usize) -> bool) -> f64 {
-    let ll = LatLong::new(b.width(), b.height());
-    let (mut err, mut sum) = (0.0, 0.0);
-    for j in 0..b.height() {
-        let d_omega = ll.row_solid_angle(j);
-        for i in 0..b.width() {
-            if mask(i, j) {
-                let (ya, yb) = (a.get(i, j).luminance(), b.get(i, j).luminance());
-                err += f64::from((ya - yb).abs()) * d_omega;
-                sum += f64::from(yb) * d_omega;
-            }
-        }
-    }
-    err / sum
+fn relative_mae(a: &Image<Rgb>, b: &Image<Rgb>, mask: impl Fn(usize, usize) -> bool + Sync) -> f64 {
+    let selected = Image::from_fn_par(b.width(), b.height(), mask);
+    ibl_metrics::relative_luminance_mae(a, b, Some(&selected)).expect("comparable probes")
 }
 
 /// Solid-angle weighted mean luminance within `cone_deg` of `axis`.

@@ -10,7 +10,7 @@ use std::path::Path;
 use ibl_capture::CaptureError;
 use ibl_capture::fisheye::{FisheyeOptions, stitch_fisheye_pair};
 use ibl_core::glam::Mat3;
-use ibl_core::{EulerDegrees, Image, LatLong, Rgb};
+use ibl_core::{EulerDegrees, Image, Rgb};
 use ibl_mapping::{Mapping, resample};
 
 const FOV: f32 = 195.0;
@@ -55,17 +55,7 @@ fn options(width: usize) -> FisheyeOptions {
 /// Relative mean absolute error of luminance, solid-angle weighted:
 /// `sum |Y_a - Y_b| dOmega / sum Y_b dOmega`.
 fn relative_mae(a: &Image<Rgb>, b: &Image<Rgb>) -> f64 {
-    let ll = LatLong::new(b.width(), b.height());
-    let (mut err, mut sum) = (0.0, 0.0);
-    for j in 0..b.height() {
-        let d_omega = ll.row_solid_angle(j);
-        for i in 0..b.width() {
-            let (ya, yb) = (a.get(i, j).luminance(), b.get(i, j).luminance());
-            err += f64::from((ya - yb).abs()) * d_omega;
-            sum += f64::from(yb) * d_omega;
-        }
-    }
-    err / sum
+    ibl_metrics::relative_luminance_mae(a, b, None).expect("comparable probes")
 }
 
 /// The two lens images side by side: a dual-fisheye frame.

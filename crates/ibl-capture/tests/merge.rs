@@ -257,6 +257,9 @@ fn linear_curve_reproduces_a_linear_bracket() {
             for (c, (n, got)) in radiance(i + 1).iter().zip(p.to_array()).enumerate() {
                 let e = *n as f64 / 255.0;
                 let got = got as f64;
+                // Linear response, one exposure per pixel: X = (n / 255) / t in f32 with
+                // power-of-two times; the weighted mean of one value is itself but for f32 rounding
+                // of the log and exp (a few 1e-7 relative); 2e-6.
                 assert!(
                     (got - e).abs() <= 2e-6 * e,
                     "pixel {i} channel {c}: {got} vs {e}"
@@ -302,6 +305,8 @@ fn merge_linear_reproduces_linear_exposures() {
                 assert_eq!(got, (e * times[0] as f32).min(1.0) * 64.0);
                 assert!(got <= e);
             } else {
+                // Unsaturated pixels: every exposure gives the same X in exact arithmetic; the
+                // weighted mean in f32 differs by rounding only (1e-7 relative); 1e-6.
                 assert!(
                     (got - e).abs() <= 1e-6 * e,
                     "pixel {i} channel {c}: {got} vs {e}"
@@ -337,6 +342,8 @@ fn weights_follow_the_closed_form() {
             .pixels()[0]
             .g as f64;
         let expected = ((w[0] * ln_e[0] + w[1] * ln_e[1]) / (w[0] + w[1])).exp();
+        // The closed form of the weighted log-average in f64 against the merge's f32: f32 rounding
+        // of exp and log (1e-7 relative); 1e-6.
         assert!(
             (got - expected).abs() < 1e-6 * expected,
             "{weighting:?}: {got} vs {expected}"
@@ -356,7 +363,11 @@ fn saturated_and_black_pixels_fall_back() {
     let curve = ResponseCurve::linear(256).unwrap();
     let merged = merge(&images, &times, &curve, &MergeOptions::default()).unwrap();
     let p = merged.image.pixels();
+    // Saturated in every exposure: the shortest exposure's value 1 / 0.5 = 2, exact in f32 to
+    // rounding; 1e-6.
     assert!((p[0].r - 1.0 / 0.5).abs() < 1e-6);
+    // Black in every exposure: the longest exposure's first code over its time, 1 / 255 / 2, to f32
+    // rounding (1e-10 absolute); 1e-9.
     assert!((p[1].r - 1.0 / 255.0 / 2.0).abs() < 1e-9);
     assert_eq!((merged.saturated_pixels, merged.black_pixels), (1, 1));
 }
@@ -467,8 +478,11 @@ fn csv_round_trip_and_linear_curve() {
 
     let linear = ResponseCurve::linear(256).unwrap();
     assert_eq!(linear.levels(), 256);
+    // The linear curve is n / 255 in f32: 255 / 255 = 1 and 51 / 255 = 0.2 to f32 rounding (1e-8);
+    // 1e-6.
     assert!((linear.exposure_of(255).g - 1.0).abs() < 1e-6);
     assert!((linear.exposure_of(51).r - 0.2).abs() < 1e-6);
+    // Code 0 is set to a quarter of code 1, 0.25 / 255, to f32 rounding (1e-10); 1e-9.
     assert!((linear.exposure_of(0).b - 0.25 / 255.0).abs() < 1e-9);
     assert_eq!(linear.exposure_of(1000), linear.exposure_of(255));
     assert!(is_parameter(ResponseCurve::linear(1)));

@@ -39,6 +39,13 @@ pub enum ImageError {
     },
 }
 
+impl ImageError {
+    /// Always true: the sizes and data come from the caller.
+    pub fn is_bad_input(&self) -> bool {
+        true
+    }
+}
+
 impl<T: Clone> Image<T> {
     /// An image filled with `value`.
     ///

@@ -151,6 +151,26 @@ impl Rgb64 {
         b: 0.0,
     };
 
+    /// Builds a triple from its three channels.
+    pub const fn new(r: f64, g: f64, b: f64) -> Self {
+        Rgb64 { r, g, b }
+    }
+
+    /// Builds a triple from an array `[r, g, b]`.
+    pub const fn from_array(a: [f64; 3]) -> Self {
+        Rgb64::new(a[0], a[1], a[2])
+    }
+
+    /// Applies `f` to each channel.
+    pub fn map(self, f: impl Fn(f64) -> f64) -> Self {
+        Rgb64::new(f(self.r), f(self.g), f(self.b))
+    }
+
+    /// Whether any channel is positive.
+    pub fn any_positive(self) -> bool {
+        self.r > 0.0 || self.g > 0.0 || self.b > 0.0
+    }
+
     /// Adds `c * w` (a radiance times a weight such as a solid angle).
     pub fn add_weighted(&mut self, c: Rgb, w: f64) {
         self.r += f64::from(c.r) * w;
@@ -178,6 +198,17 @@ impl Add for Rgb64 {
             r: self.r + o.r,
             g: self.g + o.g,
             b: self.b + o.b,
+        }
+    }
+}
+
+impl Index<usize> for Rgb64 {
+    type Output = f64;
+    fn index(&self, c: usize) -> &f64 {
+        match c {
+            0 => &self.r,
+            1 => &self.g,
+            _ => &self.b,
         }
     }
 }

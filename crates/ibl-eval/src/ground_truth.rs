@@ -266,7 +266,7 @@ impl GroundTruth {
     ///
     /// # Panics
     /// If `approx.len()` differs from the number of normals.
-    pub fn error_of(&self, approx: &[[f64; 3]]) -> crate::IrradianceError {
-        crate::IrradianceError::between(&self.irradiance, approx)
+    pub fn error_of(&self, approx: &[[f64; 3]]) -> ibl_metrics::IrradianceError {
+        ibl_metrics::IrradianceError::between(&self.irradiance, approx)
     }
 }

@@ -7,7 +7,7 @@
 //!   `s` (nearest neighbour) to at least [`OverlayOptions::min_width`] pixels, so that markers stay
 //!   legible on small probes; pixel `(i, j)` of the probe becomes the block `[s i, s i + s) x
 //!   [s j, s j + s)`.
-//! - **Regions** ([`ibl_extract::PixelRegion`], region methods only): the inner border of each
+//! - **Regions** ([`ibl_light::PixelRegion`], region methods only): the inner border of each
 //!   block of probe pixels, `max(1, s / 2)` pixels thick, in [`REGION_COLOR`]; neighbouring
 //!   regions therefore show a double line between them.
 //! - **Markers**: a light with direction `w` (world frame, CONVENTIONS section 1) sits at lat-long
@@ -22,9 +22,9 @@
 //! Pure computation: the caller encodes the result (e.g. `ibl_io::ldr::encode_png`).
 
 use ibl_core::rgb::Rgb64;
+use ibl_core::tonemap::{Display, ToneCurve};
 use ibl_core::{Image, LatLong, Rgb};
-use ibl_extract::{LightSet, PixelRegion};
-use ibl_io::{Display, ToneCurve};
+use ibl_light::{LightSet, PixelRegion};
 
 /// Colour of region outlines (8-bit sRGB).
 pub const REGION_COLOR: [u8; 3] = [255, 214, 0];
@@ -71,10 +71,10 @@ pub fn draw_overlay(
     options: &OverlayOptions,
 ) -> Image<[u8; 3]> {
     let display = Display {
-        exposure_stops: ibl_io::tonemap::auto_exposure_stops(probe),
+        exposure_stops: ibl_core::tonemap::auto_exposure_stops(probe),
         curve: ToneCurve::Reinhard,
     };
-    let base = ibl_io::tonemap::to_srgb8(probe, &display);
+    let base = ibl_core::tonemap::to_srgb8(probe, &display);
     let (w, h) = (probe.width(), probe.height());
     if w == 0 || h == 0 {
         return base;
@@ -98,7 +98,11 @@ pub fn draw_overlay(
         .luminance()
         .max(0.0)
     };
-    let total: f64 = set.lights.iter().map(|l| lum(l.irradiance)).sum();
+    let total: f64 = set
+        .lights
+        .iter()
+        .map(|l| lum(l.irradiance.to_array()))
+        .sum();
     let n = set.lights.len().max(1) as f64;
     let unit = (canvas.height() as f64 / 256.0).max(1.0);
     let mut markers: Vec<(f64, f64, f64)> = set
@@ -106,11 +110,11 @@ pub fn draw_overlay(
         .iter()
         .map(|l| {
             let share = if total > 0.0 {
-                lum(l.irradiance) / total
+                lum(l.irradiance.to_array()) / total
             } else {
                 1.0 / n
             };
-            let (u, v) = LatLong::dir_to_uv(l.dir());
+            let (u, v) = LatLong::dir_to_uv(l.direction);
             let steps = (10.0 + 3.0 * share.max(1e-300).log10()).clamp(1.5, 10.0);
             (
                 u * canvas.width() as f64,
@@ -175,16 +179,24 @@ fn disc(canvas: &mut Image<[u8; 3]>, cx: f64, cy: f64, r: f64, color: [u8; 3]) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use ibl_extract::Light;
+    use ibl_core::glam::DVec3;
+    use ibl_core::rgb::Rgb64;
+    use ibl_light::{Extraction, Light, Provenance};
 
     fn light(direction: [f64; 3], irradiance: f64, region: Option<PixelRegion>) -> Light {
         Light {
-            direction,
+            direction: DVec3::from_array(direction),
             radiance: Rgb::splat(1.0),
             solid_angle_sr: 1.0,
-            irradiance: [irradiance; 3],
+            irradiance: Rgb64::new(irradiance, irradiance, irradiance),
             region,
         }
+    }
+
+    fn test_provenance() -> Provenance {
+        Provenance::extracted(Extraction::Unknown {
+            name: "test".into(),
+        })
     }
 
     fn grey_probe(w: usize, h: usize) -> Image<Rgb> {
@@ -196,7 +208,7 @@ mod tests {
         let probe = grey_probe(64, 32);
         let dirs = [[0.0, 0.0, -1.0], [0.6, 0.64, 0.48], [-0.8, -0.36, 0.48]];
         let set = LightSet {
-            method: "test".into(),
+            provenance: test_provenance(),
             lights: dirs.iter().map(|d| light(*d, 1.0, None)).collect(),
         };
         let img = draw_overlay(&probe, &set, &OverlayOptions::default());
@@ -216,7 +228,7 @@ mod tests {
     fn brighter_lights_get_bigger_markers() {
         let probe = grey_probe(128, 64);
         let set = LightSet {
-            method: "test".into(),
+            provenance: test_provenance(),
             lights: vec![
                 light([0.0, 0.0, -1.0], 100.0, None),
                 light([0.0, 0.0, 1.0], 0.01, None),
@@ -250,7 +262,7 @@ mod tests {
         };
         // The light sits at the nadir, far below the region, so its marker covers no outline.
         let set = LightSet {
-            method: "test".into(),
+            provenance: test_provenance(),
             lights: vec![light([0.0, -1.0, 0.0], 1.0, Some(region))],
         };
         let img = draw_overlay(&probe, &set, &OverlayOptions { min_width: 0 });
@@ -304,7 +316,7 @@ mod tests {
     #[test]
     fn empty_sets_and_probes_do_not_panic() {
         let set = LightSet {
-            method: "none".into(),
+            provenance: test_provenance(),
             lights: vec![],
         };
         let img = draw_overlay(&grey_probe(16, 8), &set, &OverlayOptions::default());

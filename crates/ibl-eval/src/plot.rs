@@ -24,7 +24,7 @@ use std::fmt;
 use std::sync::OnceLock;
 
 use ibl_core::Image;
-use ibl_extract::Method;
+use ibl_light::Method;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::FontStyle;
@@ -54,6 +54,12 @@ impl fmt::Display for PlotError {
 impl std::error::Error for PlotError {}
 
 impl PlotError {
+    /// Always false: a chart that cannot be drawn is an internal failure (font, backend), never
+    /// the user's input.
+    pub fn is_bad_input(&self) -> bool {
+        false
+    }
+
     /// Wraps a drawing error.
     pub(crate) fn drawing(e: impl fmt::Display) -> Self {
         PlotError(format!("drawing failed: {e}"))

@@ -2,7 +2,7 @@
 //! methods are compared on renders with shadows as well as on irradiance): for one scene, the
 //! path-traced reference, then for every method and light count N a render in the `lights` mode,
 //! each scored against the reference by relative MSE (mean of `(a - b)^2 / (b^2 + 0.01)` over
-//! pixels and channels) and by FLIP ([`mod@crate::flip`]).
+//! pixels and channels) and by FLIP ([`ibl_metrics::flip()`]).
 //!
 //! What is compared is the rendered local scene *with* the objects (ground, object and its
 //! shadow, background where the camera sees no geometry), so every approximation is judged on
@@ -19,15 +19,14 @@
 use std::time::Instant;
 
 use ibl_core::{Image, Rgb};
-use ibl_extract::{ExtractOptions, ModelSpec, build_model};
+use ibl_extract::{ExtractError, ExtractOptions, ModelSpec, build_model};
+use ibl_metrics::{DifferenceError, FlipOptions, ImageDifference, flip};
 use ibl_render::lighting::Lighting;
 use ibl_render::{RenderError, RenderOutput, RenderSettings, render};
 use ibl_scene::description::CompositeRule;
 use ibl_scene::{Scene, ShadowKind};
 use serde::Serialize;
 
-use crate::flip::{FlipOptions, flip};
-use crate::image_difference::ImageDifference;
 use crate::plot::{Curve, CurvePoint, ErrorChart};
 
 /// What to render and compare.
@@ -119,11 +118,35 @@ fn settings(s: &RenderStudySettings, spp: u32, seed: u64) -> RenderSettings {
     }
 }
 
-fn score(test: &Image<Rgb>, reference: &Image<Rgb>) -> Result<(f64, f64, f64), RenderError> {
-    let d = ImageDifference::between(test, reference, None)
-        .map_err(|e| RenderError::Parameter(e.to_string()))?;
-    let f = flip(test, reference, &FlipOptions::default())
-        .map_err(|e| RenderError::Parameter(e.to_string()))?;
+/// Why a study could not run, by cause.
+#[derive(Debug, thiserror::Error)]
+pub enum StudyError {
+    /// A render failed (a setting out of range, a probe that cannot light).
+    #[error(transparent)]
+    Render(#[from] RenderError),
+    /// The lights could not be extracted.
+    #[error("extracting the lights: {0}")]
+    Extract(#[from] ExtractError),
+    /// Two renders could not be compared (they differ in size).
+    #[error("scoring a render: {0}")]
+    Score(#[from] DifferenceError),
+}
+
+impl StudyError {
+    /// Whether the scene or the settings are at fault (every cause is: the study has no internal
+    /// failure of its own).
+    pub fn is_bad_input(&self) -> bool {
+        match self {
+            StudyError::Render(e) => e.is_bad_input(),
+            StudyError::Extract(e) => e.is_bad_input(),
+            StudyError::Score(e) => e.is_bad_input(),
+        }
+    }
+}
+
+fn score(test: &Image<Rgb>, reference: &Image<Rgb>) -> Result<(f64, f64, f64), DifferenceError> {
+    let d = ImageDifference::between(test, reference, None)?;
+    let f = flip(test, reference, &FlipOptions::default())?;
     Ok((d.relative_mse, d.rmse, f.mean()))
 }
 
@@ -133,7 +156,7 @@ pub fn render_study(
     name: &str,
     s: &RenderStudySettings,
     progress: &(dyn Fn(usize, usize) + Sync),
-) -> Result<(RenderStudy, RenderStudyImages), RenderError> {
+) -> Result<(RenderStudy, RenderStudyImages), StudyError> {
     let runs: Vec<(ModelSpec, usize)> = s
         .methods
         .iter()
@@ -141,7 +164,7 @@ pub fn render_study(
         .collect();
     let total = runs.len() + 2;
     let no_rows = |_: usize, _: usize| {};
-    let reference_lighting = Lighting::reference(scene)?;
+    let reference_lighting = Lighting::reference(scene).map_err(RenderError::from)?;
     let started = Instant::now();
     let reference = render(
         scene,
@@ -179,7 +202,7 @@ pub fn render_study(
             progress(k + 3, total);
             continue;
         };
-        let lighting = Lighting::lights(scene, set, s.shadows)?;
+        let lighting = Lighting::lights(scene, set, s.shadows).map_err(RenderError::from)?;
         let started = Instant::now();
         let out = render(
             scene,

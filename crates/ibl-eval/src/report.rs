@@ -10,8 +10,6 @@
 
 use std::fmt::Write as _;
 
-use serde::{Deserialize, Serialize};
-
 use crate::sweep::{AverageRow, FastPathRow, Report, Row, Status};
 
 /// The header line of `report.csv`.
@@ -22,47 +20,6 @@ pub const THRESHOLDS_PCT: [f64; 2] = [1.0, 5.0];
 
 /// Light counts whose method averages `report.md` tabulates (when they were swept).
 pub const SUMMARY_COUNTS: [usize; 2] = [16, 64];
-
-/// One error-vs-N plot, as SVG and PNG (paths relative to `report.json`).
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct PlotFiles {
-    /// The probe plotted, or `None` for the average over probes.
-    pub probe: Option<String>,
-    /// The SVG file.
-    pub svg: String,
-    /// The PNG file.
-    pub png: String,
-}
-
-/// The figures of one method at one N on one probe (paths relative to `report.json`).
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct FigureFiles {
-    /// Probe name.
-    pub probe: String,
-    /// Method name.
-    pub method: String,
-    /// Light count.
-    pub n: usize,
-    /// Irradiance spheres: ground truth, approximation and error map (Figure 4 of the paper).
-    pub sphere: Option<String>,
-    /// The lights drawn over the probe.
-    pub overlay: Option<String>,
-}
-
-/// Every file of a report, relative to the folder of `report.json`.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct ReportFiles {
-    /// `report.json`.
-    pub json: String,
-    /// `report.csv`.
-    pub csv: String,
-    /// `report.md`.
-    pub markdown: String,
-    /// Error-vs-N plots: the average first, then one per probe.
-    pub plots: Vec<PlotFiles>,
-    /// Spheres and overlays at the figure N.
-    pub figures: Vec<FigureFiles>,
-}
 
 /// A CSV field, quoted when it holds a comma, a quote or a line break (RFC 4180).
 fn csv_field(s: &str) -> String {
@@ -377,7 +334,7 @@ fn write_not_ok(out: &mut String, report: &Report) {
 
 /// Writes the power check of region methods and any fit that did not converge.
 fn write_checks(out: &mut String, report: &Report) {
-    let region: Vec<&str> = ibl_extract::Method::ALL
+    let region: Vec<&str> = ibl_light::Method::ALL
         .into_iter()
         .filter(|m| m.is_region_based())
         .map(|m| m.name())

@@ -25,13 +25,14 @@
 //! the top colour. A legend bar beside the map gives the scale.
 
 use ibl_core::glam::DVec3;
+use ibl_core::tonemap::linear_to_srgb8;
 use ibl_core::{Image, RowIrradiance};
-use ibl_extract::LightSet;
-use ibl_io::tonemap::linear_to_srgb8;
+use ibl_light::LightSet;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, VPos};
 use rayon::prelude::*;
 
+use crate::colour_scale::viridis;
 use crate::plot::{PlotError, TextMode, draw_label, ensure_font, rgb_image};
 
 /// Default side of one sphere view, pixels.
@@ -136,31 +137,6 @@ impl SphereField {
             .filter(|v| v.is_finite())
             .fold(0.0, f64::max)
     }
-}
-
-/// The viridis colour map (matplotlib), nine stops from 0 to 1, sRGB.
-const VIRIDIS: [[u8; 3]; 9] = [
-    [68, 1, 84],
-    [71, 44, 122],
-    [59, 81, 139],
-    [44, 113, 142],
-    [33, 144, 141],
-    [39, 173, 129],
-    [92, 200, 99],
-    [170, 220, 50],
-    [253, 231, 37],
-];
-
-/// Viridis at `t` in `[0, 1]` (clamped; NaN is the top colour), linear between stops in sRGB.
-pub fn viridis(t: f64) -> [u8; 3] {
-    let t = if t.is_nan() { 1.0 } else { t.clamp(0.0, 1.0) };
-    let x = t * (VIRIDIS.len() - 1) as f64;
-    let k = (x.floor() as usize).min(VIRIDIS.len() - 2);
-    let f = x - k as f64;
-    let (a, b) = (VIRIDIS[k], VIRIDIS[k + 1]);
-    std::array::from_fn(|c| {
-        (f64::from(a[c]) + f * (f64::from(b[c]) - f64::from(a[c]))).round() as u8
-    })
 }
 
 /// Settings and labels of a sphere figure.
@@ -391,15 +367,6 @@ mod tests {
     }
 
     #[test]
-    fn viridis_ends_and_clamps() {
-        assert_eq!(viridis(0.0), VIRIDIS[0]);
-        assert_eq!(viridis(1.0), VIRIDIS[8]);
-        assert_eq!(viridis(7.0), VIRIDIS[8]);
-        assert_eq!(viridis(-1.0), VIRIDIS[0]);
-        assert_eq!(viridis(0.5), VIRIDIS[4]);
-    }
-
-    #[test]
     fn figure_of_a_perfect_approximation_has_no_error_colour() {
         let f = SphereField::new(32, |n| [1.0 + n.y, 1.0, 0.5]);
         let labels = SphereFigure {
@@ -412,6 +379,6 @@ mod tests {
         // Centre of the error panel of the first view.
         let x = MARGIN + LABEL_W + 2 * (32 + GAP) + 16;
         let y = HEADER_H + COLUMN_H + 16;
-        assert_eq!(*img.get(x, y), VIRIDIS[0]);
+        assert_eq!(*img.get(x, y), viridis(0.0));
     }
 }

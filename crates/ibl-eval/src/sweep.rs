@@ -29,12 +29,13 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::time::Instant;
 
 use ibl_core::{Image, LatLong, Rgb};
-use ibl_extract::{ExtractOptions, LightSet, Method, Model, ModelSpec};
+use ibl_extract::{ExtractOptions, Model, ModelSpec};
+use ibl_light::{LightSet, Method};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::GroundTruth;
-use crate::report::ReportFiles;
+use crate::report_files::ReportFiles;
 
 /// The `format` field of `report.json`.
 pub const REPORT_FORMAT: &str = "iblkit.eval/1";
@@ -73,6 +74,13 @@ pub struct SweepError(pub String);
 impl fmt::Display for SweepError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(&self.0)
+    }
+}
+
+impl SweepError {
+    /// Always true: a sweep fails only on unusable options (see [`sweep`]).
+    pub fn is_bad_input(&self) -> bool {
+        true
     }
 }
 

@@ -20,7 +20,8 @@ use std::path::{Path, PathBuf};
 
 use ibl_core::{Image, Rgb};
 use ibl_eval::{ProbeInput, Status, SweepOptions, sweep};
-use ibl_extract::{ExtractOptions, Method, ModelSpec};
+use ibl_extract::{ExtractOptions, ModelSpec};
+use ibl_light::Method;
 use serde::{Deserialize, Serialize};
 
 const GOLDEN_FORMAT: &str = "iblkit.golden.extraction/1";

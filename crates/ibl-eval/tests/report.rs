@@ -14,7 +14,8 @@ use ibl_eval::{
     ErrorChart, PLOT_SIZE, ProbeInput, Report, SphereField, SphereFigure, Status, SweepOptions,
     SweepProgress, render_png, render_svg, sweep,
 };
-use ibl_extract::{ExtractOptions, Method};
+use ibl_extract::ExtractOptions;
+use ibl_light::Method;
 
 /// A 64 x 32 lat-long probe: a dim sky gradient, a dark ground and a bright 2 x 2 "sun".
 fn synthetic_probe() -> Image<Rgb> {

@@ -50,12 +50,13 @@
 //! count is an error.
 
 use ibl_core::{Image, Rgb};
+use ibl_light::{Extraction, LightSet, Provenance};
 
+use crate::ExtractError;
 use crate::region_stats::{
     Grid, SplitPlan, direction_table, error_bound, median_cut_split, region_lights,
     split_best_first,
 };
-use crate::{ExtractError, LightSet};
 
 /// Adaptive median cut of a lat-long probe into exactly `n` lights (`1 <= n <= W H`).
 pub fn adaptive_median_cut(probe: &Image<Rgb>, n: usize) -> Result<LightSet, ExtractError> {
@@ -77,7 +78,7 @@ pub fn adaptive_median_cut(probe: &Image<Rgb>, n: usize) -> Result<LightSet, Ext
         })
     });
     Ok(LightSet {
-        method: "adaptive-median-cut".into(),
+        provenance: Provenance::extracted(Extraction::AdaptiveMedianCut),
         lights: region_lights(probe, &grid, &regions, Some(&table)),
     })
 }

@@ -19,10 +19,11 @@
 
 use ibl_core::glam::DVec3;
 use ibl_core::{Image, Rgb};
+use ibl_light::LightSet;
 use ibl_sh::{IrradianceSh, RadianceSh, Window, basis, project_latlong};
 use rayon::prelude::*;
 
-use crate::{ExtractError, LightSet};
+use crate::ExtractError;
 
 /// Directional lights plus an SH ambient (see the module doc).
 #[derive(Clone, Debug, PartialEq)]
@@ -46,9 +47,9 @@ impl Hybrid {
         let bands = probe_sh.bands();
         let mut coeffs = probe_sh.coefficients().to_vec();
         for light in &lights.lights {
-            let y = basis(light.dir(), bands);
+            let y = basis(light.direction, bands);
             for (c, yk) in coeffs.iter_mut().zip(&y) {
-                for (v, power) in c.iter_mut().zip(light.irradiance) {
+                for (v, power) in c.iter_mut().zip(light.irradiance.to_array()) {
                     *v -= power * yk;
                 }
             }

@@ -57,16 +57,14 @@
 //! better.) The Cholesky solve costs O((5N)^3). Results are bit-identical whatever the thread
 //! count.
 
-use std::collections::BTreeMap;
-
 use glam::{DMat3, DVec3};
 use ibl_core::rgb::Rgb64;
 use ibl_core::{Image, Rgb, RowIrradiance, channel_means, fibonacci_normals};
+use ibl_light::{Extraction, FitReport, Light, LightSet, Provenance};
 use nalgebra::{DMatrix, DMatrixViewMut, DVector};
 use rayon::prelude::*;
 
-use crate::cholesky::{cholesky_in_place, cholesky_solve};
-use crate::light_set::{Light, LightSet};
+use crate::cholesky::solve_spd;
 use crate::lune_gram::{cosine_overlap, feature_block};
 use crate::normal_lanes::{ChannelValues, NormalLanes};
 use crate::{ExtractError, nnls_gram};
@@ -107,47 +105,6 @@ impl Default for OptimizationOptions {
             level_iterations: 20,
             relative_tolerance: 1e-3,
         }
-    }
-}
-
-/// How a fit went.
-#[derive(Clone, Debug, PartialEq, Default)]
-pub struct FitReport {
-    /// Levenberg-Marquardt iterations at the final level.
-    pub iterations: usize,
-    /// Iterations over all continuation levels.
-    pub total_iterations: usize,
-    /// True when the final level stopped on its convergence test, not on the iteration cap.
-    pub converged: bool,
-    /// Cost `F` (see the module doc) when the final level started.
-    pub initial_cost: f64,
-    /// Cost `F` at the end.
-    pub final_cost: f64,
-    /// RMS of the scaled residuals on the fitting normals at the end, % of mean irradiance.
-    pub fit_rms_err_pct: f64,
-    /// Mean absolute error on the fitting normals at the end, % of mean irradiance.
-    pub fit_mean_abs_err_pct: f64,
-}
-
-impl FitReport {
-    /// The report as named numbers (`converged` is 1 or 0).
-    pub fn parameters(&self) -> BTreeMap<String, f64> {
-        BTreeMap::from([
-            ("iterations".to_string(), self.iterations as f64),
-            ("total_iterations".to_string(), self.total_iterations as f64),
-            (
-                "converged".to_string(),
-                if self.converged { 1.0 } else { 0.0 },
-            ),
-            ("initial_cost".to_string(), self.initial_cost),
-            ("final_cost".to_string(), self.final_cost),
-            ("fit_rms_err_pct".to_string(), self.fit_rms_err_pct),
-            (
-                "fit_mean_abs_err_pct".to_string(),
-                self.fit_mean_abs_err_pct,
-            ),
-            ("fit_normals".to_string(), FIT_NORMAL_COUNT as f64),
-        ])
     }
 }
 
@@ -287,7 +244,7 @@ pub fn fit_irradiance(
         inv_mu,
     };
     if inv_mu.iter().all(|&v| v == 0.0) {
-        return Ok(black_fit(n));
+        return Ok(black_fit(n, problem.normals.len()));
     }
     // Continuation levels: n, ceil(n/2), ..., 1, fitted from the smallest.
     let mut levels = vec![n];
@@ -365,8 +322,9 @@ pub fn fit_irradiance(
     }
     report.total_iterations = total_iterations;
     report.fit_mean_abs_err_pct = problem.mean_abs_err_pct(&lights);
+    report.fit_normals = problem.normals.len();
     Ok(Fit {
-        set: problem.light_set(&lights),
+        set: problem.light_set(&lights, &report),
         report,
     })
 }
@@ -425,27 +383,30 @@ fn report_of(problem: &Problem, outcome: &Outcome, iterations: usize, total: usi
     }
 }
 
-/// `n` zero-power lights for a black probe (nothing to fit; converged by definition).
-fn black_fit(n: usize) -> Fit {
+/// `n` zero-power lights for a black probe (nothing to fit on `normals` normals; converged by
+/// definition).
+fn black_fit(n: usize, normals: usize) -> Fit {
     let lights = fibonacci_normals(n)
         .into_iter()
         .map(|d| Light {
-            direction: d.to_array(),
+            direction: d,
             radiance: Rgb::ZERO,
             solid_angle_sr: SOURCE_SOLID_ANGLE_SR,
-            irradiance: [0.0; 3],
+            irradiance: Rgb64::ZERO,
             region: None,
         })
         .collect();
+    let report = FitReport {
+        converged: true,
+        fit_normals: normals,
+        ..Default::default()
+    };
     Fit {
         set: LightSet {
-            method: "irradiance-optimization".into(),
+            provenance: Provenance::extracted(Extraction::IrradianceOptimization(report.clone())),
             lights,
         },
-        report: FitReport {
-            converged: true,
-            ..Default::default()
-        },
+        report,
     }
 }
 
@@ -730,26 +691,27 @@ impl Problem {
         g
     }
 
-    /// The fitted lights as a light set, strongest (luminance power) first.
-    fn light_set(&self, lights: &Lights) -> LightSet {
+    /// The fitted lights as a light set, strongest (luminance power) first, with the fit's report
+    /// as its provenance.
+    fn light_set(&self, lights: &Lights, report: &FitReport) -> LightSet {
         let mut out: Vec<Light> = (0..lights.len())
             .map(|i| {
                 let p = lights.power(i);
                 let irradiance = [0, 1, 2].map(|c| if self.inv_mu[c] == 0.0 { 0.0 } else { p[c] });
                 let radiance = irradiance.map(|v| (v / SOURCE_SOLID_ANGLE_SR) as f32);
                 Light {
-                    direction: lights.dirs[i].to_array(),
+                    direction: lights.dirs[i],
                     radiance: Rgb::new(radiance[0], radiance[1], radiance[2]),
                     solid_angle_sr: SOURCE_SOLID_ANGLE_SR,
-                    irradiance,
+                    irradiance: Rgb64::from_array(irradiance),
                     region: None,
                 }
             })
             .collect();
-        let lum = |l: &Light| luminance(l.irradiance);
+        let lum = |l: &Light| l.irradiance.luminance();
         out.sort_by(|a, b| lum(b).total_cmp(&lum(a)));
         LightSet {
-            method: "irradiance-optimization".into(),
+            provenance: Provenance::extracted(Extraction::IrradianceOptimization(report.clone())),
             lights: out,
         }
     }
@@ -824,11 +786,7 @@ fn levenberg_marquardt(
             for i in 0..np {
                 a[(i, i)] += lambda * h[(i, i)].max(floor);
             }
-            let delta = if cholesky_in_place(&mut a) {
-                cholesky_solve(&a, &(-&g))
-            } else {
-                None
-            };
+            let delta = solve_spd(&a, &(-&g));
             let Some(delta) = delta else {
                 lambda *= nu;
                 nu *= 2.0;

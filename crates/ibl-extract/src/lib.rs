@@ -1,13 +1,13 @@
 //! Light extraction (Madsen & Laursen 2006): replacing a lat-long light probe by N directional
-//! lights. Each method lives in its own module and returns a [`LightSet`] in the world frame
-//! (CONVENTIONS section 4): per light a direction, an RGB radiance, a solid angle and the
-//! irradiance `I = L A` it gives a surface facing it.
+//! lights. Each method lives in its own module and returns an [`ibl_light::LightSet`] in the
+//! world frame (CONVENTIONS section 4): per light a direction, an RGB radiance, a solid angle and
+//! the irradiance `I = L A` it gives a surface facing it, with the method and its parameters as
+//! the set's provenance. The light types and the method names live in `ibl-light`.
 
 pub mod adaptive_median_cut;
 mod cholesky;
 pub mod hybrid;
 pub mod irradiance_optimization;
-pub mod light_set;
 pub mod lightgen;
 mod lune_gram;
 pub mod median_cut;
@@ -21,12 +21,11 @@ pub mod variance_minimization;
 
 pub use adaptive_median_cut::adaptive_median_cut;
 pub use hybrid::Hybrid;
-pub use irradiance_optimization::{Fit, FitReport, OptimizationOptions, irradiance_optimization};
-pub use light_set::{Light, LightSet, PixelRegion};
+pub use irradiance_optimization::{Fit, OptimizationOptions, irradiance_optimization};
 pub use lightgen::{LightGenOptions, lightgen};
 pub use median_cut::median_cut;
-pub use method::{ExtractOptions, Extraction, Method, extract};
-pub use model::{LightSource, Model, ModelSpec, build_model};
+pub use method::{ExtractOptions, extract};
+pub use model::{Model, ModelSpec, build_model};
 pub use nnls::nnls_gram;
 pub use sun::{DominantLight, dominant_light};
 pub use variance_minimization::variance_minimization;
@@ -40,4 +39,14 @@ pub enum ExtractError {
     /// The probe is not a usable lat-long map.
     #[error("{0}")]
     Invalid(String),
+}
+
+impl ExtractError {
+    /// Always true: both causes are the caller's input (a parameter out of range, a probe that is
+    /// not a usable lat-long map); extraction has no internal failure mode that returns.
+    pub fn is_bad_input(&self) -> bool {
+        match self {
+            ExtractError::Parameter(_) | ExtractError::Invalid(_) => true,
+        }
+    }
 }

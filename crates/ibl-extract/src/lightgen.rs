@@ -54,12 +54,13 @@
 
 use glam::DVec3;
 use ibl_core::{Image, Rgb};
+use ibl_light::{Extraction, LightSet, Provenance};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 use rayon::prelude::*;
 
+use crate::ExtractError;
 use crate::region_stats::{Grid, clamped, light};
-use crate::{ExtractError, LightSet};
 
 /// Clustering settings.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -214,7 +215,10 @@ pub fn lightgen(
         .collect();
     lights.sort_by(|a, b| b.0.total_cmp(&a.0));
     Ok(LightSet {
-        method: "lightgen".into(),
+        provenance: Provenance::extracted(Extraction::LightGen {
+            restarts: o.restarts,
+            seed: o.seed,
+        }),
         lights: lights.into_iter().map(|(_, l)| l).collect(),
     })
 }

@@ -23,20 +23,17 @@
 //! (`region_stats.rs`).
 
 use ibl_core::{Image, Rgb};
+use ibl_light::{Extraction, LightSet, MAX_MEDIAN_CUT_SPLITS, Provenance};
 
 use crate::ExtractError;
-use crate::light_set::LightSet;
 use crate::region_stats::{Grid, energy_table, median_cut_split, region_lights};
-
-/// Largest number of rounds accepted (2^16 lights).
-pub const MAX_SPLITS: u32 = 16;
 
 /// Median cut of a lat-long probe into `2^splits` lights.
 pub fn median_cut(probe: &Image<Rgb>, splits: u32) -> Result<LightSet, ExtractError> {
     let grid = Grid::new(probe)?;
-    if splits > MAX_SPLITS {
+    if splits > MAX_MEDIAN_CUT_SPLITS {
         return Err(ExtractError::Parameter(format!(
-            "median cut with {splits} rounds would make 2^{splits} lights (at most {MAX_SPLITS} rounds)"
+            "median cut with {splits} rounds would make 2^{splits} lights (at most {MAX_MEDIAN_CUT_SPLITS} rounds)"
         )));
     }
     let energy = energy_table(probe, &grid);
@@ -53,7 +50,7 @@ pub fn median_cut(probe: &Image<Rgb>, splits: u32) -> Result<LightSet, ExtractEr
             .collect();
     }
     Ok(LightSet {
-        method: "median-cut".into(),
+        provenance: Provenance::extracted(Extraction::MedianCut { splits }),
         lights: region_lights(probe, &grid, &regions, None),
     })
 }

@@ -21,19 +21,10 @@ use ibl_core::{Image, Rgb};
 use ibl_sh::{IrradianceSh, MAX_BANDS, Window, project_latlong};
 use rayon::prelude::*;
 
-use crate::sun::COMPACT_SOLID_ANGLE_SR;
-use crate::{
-    ExtractError, ExtractOptions, Hybrid, Light, LightSet, Method, dominant_light, extract,
-};
+use ibl_light::{Extraction, Light, LightSet, LightSource, Method, Provenance};
 
-/// Where a model's lights come from.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum LightSource {
-    /// An extraction method, N lights.
-    Method(Method),
-    /// The probe's dominant compact light ([`crate::dominant_light`]), one light.
-    Sun,
-}
+use crate::sun::COMPACT_SOLID_ANGLE_SR;
+use crate::{ExtractError, ExtractOptions, Hybrid, dominant_light, extract};
 
 /// A lighting model by name (see the module doc).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -52,22 +43,6 @@ pub enum ModelSpec {
         /// Bands.
         bands: usize,
     },
-}
-
-impl LightSource {
-    fn name(self) -> &'static str {
-        match self {
-            LightSource::Method(m) => m.name(),
-            LightSource::Sun => "sun",
-        }
-    }
-
-    fn accepts(self, n: usize) -> bool {
-        match self {
-            LightSource::Method(m) => m.accepts(n),
-            LightSource::Sun => n == 1,
-        }
-    }
 }
 
 impl ModelSpec {
@@ -126,17 +101,12 @@ impl FromStr for ModelSpec {
 
     fn from_str(s: &str) -> Result<Self, Self::Err> {
         let source = |name: &str| -> Result<LightSource, ExtractError> {
-            if name == "sun" {
-                Ok(LightSource::Sun)
-            } else {
-                name.parse::<Method>().map(LightSource::Method).map_err(|_| {
-                    let names: Vec<&str> = Method::ALL.iter().map(|m| m.name()).collect();
-                    ExtractError::Parameter(format!(
-                        "unknown method '{s}' (expected one of: {}, sun; any of them +sh<B>; or sh<B>)",
-                        names.join(", ")
-                    ))
-                })
-            }
+            name.parse::<LightSource>().map_err(|_| {
+                ExtractError::Parameter(format!(
+                    "unknown method '{s}' (expected one of: {}, sun; any of them +sh<B>; or sh<B>)",
+                    Method::names()
+                ))
+            })
         };
         if let Some((lights, bands)) = s.split_once("+sh") {
             return Ok(ModelSpec::Hybrid {
@@ -211,20 +181,21 @@ fn sun_set(
     parameters.insert("sun_solid_angle_sr".into(), sun.solid_angle_sr);
     let used = !compact_only || sun.solid_angle_sr <= COMPACT_SOLID_ANGLE_SR;
     parameters.insert("sun_used".into(), if used { 1.0 } else { 0.0 });
+    let provenance = Provenance::extracted(Extraction::DominantLight);
     if !used {
         return Ok(LightSet {
-            method: "sun".into(),
+            provenance,
             lights: Vec::new(),
         });
     }
-    let radiance = sun.radiance.map(|v| v as f32);
+    let radiance = sun.radiance;
     Ok(LightSet {
-        method: "sun".into(),
+        provenance,
         lights: vec![Light {
             direction: sun.direction,
-            radiance: Rgb::new(radiance[0], radiance[1], radiance[2]),
+            radiance: Rgb::new(radiance.r as f32, radiance.g as f32, radiance.b as f32),
             solid_angle_sr: sun.solid_angle_sr,
-            irradiance: sun.power,
+            irradiance: sun.irradiance,
             region: None,
         }],
     })
@@ -250,9 +221,8 @@ pub fn build_model(
     let mut parameters = BTreeMap::new();
     let lights =
         |source: LightSource, hybrid: bool, parameters: &mut BTreeMap<String, f64>| match source {
-            LightSource::Method(m) => extract(probe, m, n, options).map(|x| {
-                parameters.extend(x.parameters);
-                x.set
+            LightSource::Method(m) => extract(probe, m, n, options).inspect(|set| {
+                parameters.extend(set.provenance.extraction.parameters());
             }),
             LightSource::Sun => sun_set(probe, hybrid, parameters),
         };

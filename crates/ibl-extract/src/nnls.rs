@@ -24,7 +24,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use crate::cholesky::{cholesky_lower, cholesky_solve};
+use crate::cholesky::solve_spd;
 
 /// Solves `min 1/2 x^T Q x - b^T x, x >= 0` (see the module doc). `q` is n x n, `b` has n rows.
 /// Returns zeros when `b` has no positive entry (the best non-negative answer then) or `Q` is
@@ -124,7 +124,7 @@ fn solve_subset(q: &DMatrix<f64>, b: &DVector<f64>, idx: &[usize], ridge: f64) -
         q[(idx[r], idx[c])] + if r == c { ridge } else { 0.0 }
     });
     let rhs = DVector::from_fn(k, |r, _| b[idx[r]]);
-    let z = cholesky_solve(&cholesky_lower(sub)?, &rhs)?;
+    let z = solve_spd(&sub, &rhs)?;
     Some(z.iter().copied().collect())
 }
 

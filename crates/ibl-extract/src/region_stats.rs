@@ -46,7 +46,8 @@ use ibl_core::{Image, LatLong, Rgb};
 use rayon::prelude::*;
 
 use crate::ExtractError;
-use crate::light_set::{Light, PixelRegion};
+use ibl_core::rgb::Rgb64;
+use ibl_light::{Light, PixelRegion};
 
 /// Rec. 709 luminance weights in f64 (the same numbers as `ibl_core::rgb::LUMINANCE_WEIGHTS`).
 const LUMINANCE: [f64; 3] = [
@@ -593,10 +594,10 @@ pub(crate) fn light(
         Rgb::ZERO
     };
     Light {
-        direction: dir.to_array(),
+        direction: dir,
         radiance,
         solid_angle_sr: solid_angle,
-        irradiance: power,
+        irradiance: Rgb64::from_array(power),
         region,
     }
 }

@@ -29,13 +29,14 @@ pub const COMPACT_SOLID_ANGLE_SR: f64 = 0.025;
 #[derive(Clone, Debug, PartialEq)]
 pub struct DominantLight {
     /// Unit direction towards the source (world frame).
-    pub direction: [f64; 3],
+    pub direction: DVec3,
     /// Solid angle of the source's pixels, sr.
     pub solid_angle_sr: f64,
     /// Mean radiance over the source, RGB, probe units.
-    pub radiance: [f64; 3],
-    /// Power `sum L dOmega` (the irradiance it gives a surface facing it), RGB.
-    pub power: [f64; 3],
+    pub radiance: Rgb64,
+    /// `sum L dOmega` over the source: the irradiance it gives a surface facing it, RGB (probe
+    /// unit x sr).
+    pub irradiance: Rgb64,
     /// Share of the probe's luminance power in the source, 0 to 1.
     pub share: f64,
     /// Confidence that this is one dominant compact source, 0 to 1.
@@ -129,10 +130,10 @@ pub fn dominant_light(probe: &Image<Rgb>) -> Result<DominantLight, ExtractError>
     let share = (lum_power / total).clamp(0.0, 1.0);
     let compactness = (COMPACT_SOLID_ANGLE_SR / solid_angle).min(1.0);
     Ok(DominantLight {
-        direction: direction.to_array(),
+        direction,
         solid_angle_sr: solid_angle,
-        radiance: power.map(|p| p / solid_angle),
-        power,
+        radiance: Rgb64::from_array(power.map(|p| p / solid_angle)),
+        irradiance: Rgb64::from_array(power),
         share,
         confidence: share * compactness,
         pixels,
@@ -163,7 +164,7 @@ mod tests {
         let dir = DVec3::new(0.4, 0.6, -0.5).normalize();
         let probe = sky_with_sun(dir, 0.05, 20_000.0);
         let sun = dominant_light(&probe).unwrap();
-        let got = DVec3::from_array(sun.direction);
+        let got = sun.direction;
         assert!(got.angle_between(dir) < 0.005, "{got} vs {dir}");
         // Power: the disc's pixels times their radiance.
         let ll = LatLong::new(512, 256);
@@ -175,8 +176,10 @@ mod tests {
                 }
             }
         }
-        assert!((sun.power[0] - want).abs() < 1e-9 * want);
-        assert!((sun.radiance[0] - 20_000.0).abs() < 1e-6);
+        // Same sum in another order: f64 rounding over ~100 pixels, far below 1e-9 relative.
+        assert!((sun.irradiance.r - want).abs() < 1e-9 * want);
+        // 20000 times a ratio of equal sums: f64 rounding, below 1e-6 absolute.
+        assert!((sun.radiance.r - 20_000.0).abs() < 1e-6);
         assert!(sun.confidence > 0.9, "{sun:?}");
     }
 
@@ -194,10 +197,7 @@ mod tests {
         for dir in [DVec3::Z, DVec3::Y] {
             let probe = sky_with_sun(dir, 0.08, 5_000.0);
             let sun = dominant_light(&probe).unwrap();
-            assert!(
-                DVec3::from_array(sun.direction).angle_between(dir) < 0.01,
-                "{dir}: {sun:?}"
-            );
+            assert!(sun.direction.angle_between(dir) < 0.01, "{dir}: {sun:?}");
             assert!(sun.share > 0.5, "{dir}: {sun:?}");
         }
     }

@@ -52,13 +52,13 @@
 //! milliseconds for a 512 x 256 probe and N = 256 on 2 cores (`benches/extract.rs`).
 
 use ibl_core::{Image, Rgb};
+use ibl_light::{Extraction, LightSet, PixelRegion, Provenance};
 
-use crate::light_set::PixelRegion;
+use crate::ExtractError;
 use crate::region_stats::{
     DirectionTable, Grid, SplitPlan, direction_table, median_cut_split, region_lights,
     sphere_variance, split_best_first,
 };
-use crate::{ExtractError, LightSet};
 
 /// Variance minimisation of a lat-long probe into exactly `n` lights (`1 <= n <= W H`).
 pub fn variance_minimization(probe: &Image<Rgb>, n: usize) -> Result<LightSet, ExtractError> {
@@ -74,7 +74,7 @@ pub fn variance_minimization(probe: &Image<Rgb>, n: usize) -> Result<LightSet, E
     let table = direction_table(probe, &grid);
     let regions = split_best_first(&grid, n, |r| plan(r, &grid, &table));
     Ok(LightSet {
-        method: "variance-minimization".into(),
+        provenance: Provenance::extracted(Extraction::VarianceMinimization),
         lights: region_lights(probe, &grid, &regions, Some(&table)),
     })
 }

@@ -6,9 +6,10 @@
 
 use std::path::Path;
 
-use ibl_core::metrics::mean_err_pct;
 use ibl_core::{Image, LatLong, Rgb, fibonacci_normals, irradiance_exact};
-use ibl_extract::{ExtractOptions, Hybrid, Light, LightSet, Method, dominant_light, extract};
+use ibl_extract::{ExtractOptions, Hybrid, dominant_light, extract};
+use ibl_light::{Extraction, Light, LightSet, Method, Provenance};
+use ibl_metrics::mean_err_pct;
 use ibl_sh::{Window, project_latlong};
 
 fn probes() -> Vec<(String, Image<Rgb>)> {
@@ -35,7 +36,7 @@ fn probe_power(probe: &Image<Rgb>) -> [f64; 3] {
 fn sun_light(probe: &Image<Rgb>) -> LightSet {
     let sun = dominant_light(probe).unwrap();
     LightSet {
-        method: "sun".into(),
+        provenance: Provenance::extracted(Extraction::DominantLight),
         lights: vec![Light {
             direction: sun.direction,
             radiance: Rgb::new(
@@ -44,7 +45,7 @@ fn sun_light(probe: &Image<Rgb>) -> LightSet {
                 sun.radiance[2] as f32,
             ),
             solid_angle_sr: sun.solid_angle_sr,
-            irradiance: sun.power,
+            irradiance: sun.irradiance,
             region: None,
         }],
     }
@@ -56,14 +57,14 @@ fn hybrid_conserves_power_and_tends_to_the_exact_irradiance() {
     for (name, probe) in probes() {
         let truth = irradiance_exact(&probe, &normals);
         let want = probe_power(&probe);
-        let lights = extract(&probe, Method::LightGen, 4, &ExtractOptions::default())
-            .unwrap()
-            .set;
+        let lights = extract(&probe, Method::LightGen, 4, &ExtractOptions::default()).unwrap();
         let mut last = f64::INFINITY;
         for bands in [3, 9, 21] {
             let hybrid = Hybrid::from_probe(&probe, lights.clone(), bands, Window::None).unwrap();
             let got = hybrid.total_power();
             for c in 0..3 {
+                // Power is conserved exactly in SH (the lights' projections are subtracted); 1e-9
+                // relative covers the f64 sums over the probe's pixels and the bands.
                 assert!(
                     (got[c] - want[c]).abs() < 1e-9 * want[c],
                     "{name}: power {got:?} vs {want:?}"
@@ -88,9 +89,7 @@ fn one_sun_and_sh9_against_sixteen_lights() {
         let sh_only = mean_err_pct(&truth, &sh.irradiance(Window::None).eval_many(&normals));
         let hybrid = Hybrid::new(&sh, sun_light(&probe), Window::None).unwrap();
         let sun_sh9 = mean_err_pct(&truth, &hybrid.irradiance_many(&normals));
-        let sixteen = extract(&probe, Method::LightGen, 16, &ExtractOptions::default())
-            .unwrap()
-            .set;
+        let sixteen = extract(&probe, Method::LightGen, 16, &ExtractOptions::default()).unwrap();
         let lights16 = mean_err_pct(
             &truth,
             &normals

@@ -11,9 +11,10 @@ use std::path::Path;
 use std::time::Instant;
 
 use ibl_core::glam::DVec3;
-use ibl_core::{Image, IrradianceError, LatLong, Rgb, fibonacci_normals, irradiance_exact};
+use ibl_core::{Image, LatLong, Rgb, fibonacci_normals, irradiance_exact};
 use ibl_extract::irradiance_optimization::{FIT_NORMAL_COUNT, fit_irradiance, fit_normals};
 use ibl_extract::{OptimizationOptions, irradiance_optimization};
+use ibl_metrics::IrradianceError;
 
 fn probes() -> Vec<(String, Image<Rgb>)> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/probes");
@@ -64,11 +65,18 @@ fn one_bright_pixel_is_one_light() {
     let light = fit.set.lights[0];
     println!(
         "one pixel: mean {mean:.2e} % max {max:.2e} % angle {:.2e} rad",
-        light.dir().angle_between(d)
+        light.direction.angle_between(d)
     );
-    assert!(light.dir().angle_between(d) < 1e-6);
+    // One bright pixel is a point light: the fit lands on its direction and power to the
+    // optimiser's convergence tolerance (1e-3 relative in cost, far finer in the five parameters of
+    // one light); 1e-6 rad and 1e-6 relative.
+    assert!(light.direction.angle_between(d) < 1e-6);
     assert!((light.irradiance[0] / power - 1.0).abs() < 1e-6);
     assert!((light.irradiance[1] / light.irradiance[0] - 0.5).abs() < 1e-6);
+    // Irradiance of a point light matched by a point light: the only error is the pixel's own
+    // extent (0.7 degrees of a 512 x 256 probe), whose effect on the clamped cosine is of order its
+    // solid angle, 1e-4 of a per cent; thresholds 1e-4 % mean and 1e-3 % max (the printed line
+    // shows the values).
     assert!(mean < 1e-4 && max < 1e-3);
     assert!(fit.report.converged);
 }
@@ -128,12 +136,12 @@ fn bad_parameters_are_errors() {
     let mut odd = Image::filled(32, 16, Rgb::new(1.0, 1.0, 1.0));
     *odd.get_mut(3, 3) = Rgb::new(f32::NAN, -5.0, f32::INFINITY);
     let fit = irradiance_optimization(&odd, 4, &OptimizationOptions::default()).unwrap();
-    assert!(
-        fit.set
-            .lights
+    assert!(fit.set.lights.iter().all(|l| {
+        l.irradiance
+            .to_array()
             .iter()
-            .all(|l| l.irradiance.iter().all(|v| v.is_finite() && *v >= 0.0))
-    );
+            .all(|v| v.is_finite() && *v >= 0.0)
+    }));
 }
 
 #[test]
@@ -169,8 +177,15 @@ fn bundled_probes_converge_and_score_within_bounds() {
             assert!(r.converged, "{name} N={n} did not converge");
             assert!(r.final_cost <= r.initial_cost);
             for l in &fit.set.lights {
-                assert!((l.dir().length() - 1.0).abs() < 1e-9);
-                assert!(l.irradiance.iter().all(|v| v.is_finite() && *v >= 0.0));
+                // Directions are renormalised after every step: unit to f64 rounding (1e-16); 1e-9
+                // leaves room for the tangent-plane update.
+                assert!((l.direction.length() - 1.0).abs() < 1e-9);
+                assert!(
+                    l.irradiance
+                        .to_array()
+                        .iter()
+                        .all(|v| v.is_finite() && *v >= 0.0)
+                );
             }
             if let Some(&(_, _, mb, xb)) = bounds.iter().find(|b| b.0 == name && b.1 == n) {
                 assert!(

@@ -78,6 +78,9 @@ fn lights_partition_the_probe_and_conserve_power_on_every_bundled_probe() {
             let got = set.total_power();
             for c in 0..3 {
                 let rel = (got[c] - want[c]).abs() / want[c];
+                // Region sums reorganise the probe's power sum (per-row f64 sums, summed-area table
+                // differences): equal to f64 rounding (about 1e-15 relative); 1e-6 is far above
+                // that and still catches any lost region.
                 assert!(
                     rel < 1e-6,
                     "{name} K={k} channel {c}: {} vs {} ({rel:e})",
@@ -86,15 +89,20 @@ fn lights_partition_the_probe_and_conserve_power_on_every_bundled_probe() {
                 );
             }
             let sr: f64 = set.lights.iter().map(|l| l.solid_angle_sr).sum();
+            // Region solid angles are exact lat-long row sums; they add to 4 pi to f64 rounding
+            // over 2^K regions (about 1e-13); 1e-9 leaves a margin of 1e4.
             assert!(
                 (sr - 4.0 * std::f64::consts::PI).abs() < 1e-9,
                 "{name} K={k}: {sr}"
             );
             for l in &set.lights {
-                let d = l.dir();
+                let d = l.direction;
+                // Centroids are normalised in f64: unit to a few ulps.
                 assert!((d.length() - 1.0).abs() < 1e-12);
                 for c in 0..3 {
                     let i = f64::from(l.radiance.to_array()[c]) * l.solid_angle_sr;
+                    // L = I / A is stored in f32: L A equals I to f32 rounding (6e-8 relative);
+                    // 1e-6 is 16 f32 ulps.
                     assert!((i - l.irradiance[c]).abs() <= 1e-6 * l.irradiance[c].max(1e-12));
                 }
             }
@@ -127,6 +135,10 @@ fn regions_hold_nearly_equal_energy() {
         .collect();
     let mean = energies.iter().sum::<f64>() / energies.len() as f64;
     for e in &energies {
+        // Cuts fall between pixel rows and columns, so a region holds half its parent's energy to
+        // within one row or column of it; on this 256 x 128 sky with 16 regions (each about 64 x 32
+        // pixels) one row or column is 1.5 to 3 % of a region; 8 % allows for both dimensions of
+        // the cuts that made it.
         assert!(
             (e / mean - 1.0).abs() < 0.08,
             "region energy {e} vs mean {mean}"
@@ -143,10 +155,13 @@ fn constant_environment_first_cut_is_down_the_middle() {
     assert_eq!((r[0].x1, r[1].x0), (32, 32));
     // Each half is a hemisphere (left: -X, right: +X) with power 2 * 2 pi.
     for (l, sign) in set.lights.iter().zip([-1.0, 1.0]) {
-        assert!((l.dir().x - sign).abs() < 1e-9, "{:?}", l.direction);
+        // The hemisphere's energy centroid is exactly -X or +X by symmetry; f64 sums over 1024
+        // pixels round to 1e-15, margin 1e6.
+        assert!((l.direction.x - sign).abs() < 1e-9, "{:?}", l.direction);
         for c in 0..3 {
             assert!((l.irradiance[c] - 4.0 * std::f64::consts::PI).abs() < 1e-9);
         }
+        // L = I / A with I = 2 * 2 pi and A = 2 pi: 2 in f32 to rounding.
         assert!((l.radiance.r - 2.0).abs() < 1e-6);
     }
 }
@@ -168,12 +183,17 @@ fn a_single_bright_pixel_becomes_one_light_in_its_direction() {
             (r.x0..r.x1).contains(&px) && (r.y0..r.y1).contains(&py)
         })
         .unwrap();
+    // The bright pixel (5e4 against 1e-3) dominates its region's energy centroid: the neighbours
+    // pull the centroid by their energy share (below 1e-6 of the region's), so cos > 0.99999 (0.26
+    // degrees) has a wide margin.
     assert!(
-        owner.dir().dot(d) > 0.99999,
+        owner.direction.dot(d) > 0.99999,
         "{:?} vs {d:?}",
         owner.direction
     );
     let pixel_power = 5e4 * ll.row_solid_angle(py);
+    // The region holds the pixel's power plus its dim neighbours' (each 5e7 times weaker): within 1
+    // % of the pixel's power.
     assert!(owner.irradiance[0] >= pixel_power && owner.irradiance[0] < pixel_power * 1.01);
 }
 

@@ -7,9 +7,9 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, Throughput};
+use ibl_core::tonemap::{Display, to_srgb8};
 use ibl_core::{Image, Rgb};
 use ibl_io::exr::{ExrCompression, ExrOptions, ExrPrecision};
-use ibl_io::tonemap::{Display, to_srgb8};
 use ibl_io::{Limits, exr, hdr, pfm};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;

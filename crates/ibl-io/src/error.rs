@@ -136,6 +136,11 @@ pub enum DecodeError {
 }
 
 impl DecodeError {
+    /// Always true: every cause is the bytes' content.
+    pub fn is_bad_input(&self) -> bool {
+        true
+    }
+
     /// Shorthand for [`DecodeError::Invalid`].
     pub(crate) fn invalid(reason: impl Into<String>) -> DecodeError {
         DecodeError::Invalid(reason.into())
@@ -161,6 +166,11 @@ pub struct EncodeError {
 }
 
 impl EncodeError {
+    /// Always false: encoding our own images fails only internally.
+    pub fn is_bad_input(&self) -> bool {
+        false
+    }
+
     /// Builds an error from any message.
     pub(crate) fn new(reason: impl Into<String>) -> EncodeError {
         EncodeError {

@@ -1,5 +1,5 @@
 //! PNG and JPEG (low dynamic range) through the `image` crate: decoding to linear RGB with the
-//! sRGB EOTF, and encoding already tone-mapped 8-bit sRGB pixels (see [`crate::tonemap`]).
+//! sRGB EOTF, and encoding already tone-mapped 8-bit sRGB pixels (see [`ibl_core::tonemap`]).
 //!
 //! Decoding accepts 8- and 16-bit grey, grey+alpha, RGB and RGBA; alpha is dropped (not
 //! premultiplied) and embedded gamma or ICC information is ignored: every file is taken to be
@@ -14,7 +14,7 @@ use rayon::prelude::*;
 
 use crate::error::{DecodeError, EncodeError};
 use crate::format::{ImageFormat, Limits, RawImage, wrong_magic};
-use crate::tonemap::srgb_to_linear;
+use ibl_core::tonemap::srgb_to_linear;
 
 /// Default JPEG quality used by [`crate::write_image`].
 pub const JPEG_QUALITY: u8 = 92;
@@ -166,11 +166,11 @@ mod tests {
         let bytes = encode_png(&img).expect("encodes");
         let raw = decode(&bytes, &Limits::default()).expect("decodes");
         assert_eq!(raw.details, "PNG, 8-bit RGB, sRGB decoded to linear");
-        let back = crate::tonemap::to_srgb8(
+        let back = ibl_core::tonemap::to_srgb8(
             &raw.image,
-            &crate::tonemap::Display {
+            &ibl_core::tonemap::Display {
                 exposure_stops: 0.0,
-                curve: crate::tonemap::ToneCurve::Clamp,
+                curve: ibl_core::tonemap::ToneCurve::Clamp,
             },
         );
         assert_eq!(back, img);

@@ -1,5 +1,5 @@
 //! File formats for iblkit: Radiance RGBE (`.hdr`), OpenEXR, PFM, PNG and JPEG in; the same out
-//! (PNG/JPEG through a tone-mapping display transform); all presented as linear radiance
+//! (PNG/JPEG through the tone-mapping display transform of `ibl_core::tonemap`); all presented as linear radiance
 //! `Image<Rgb>` with row 0 at the top (`docs/CONVENTIONS.md`, sections 2, 4 and 7).
 //!
 //! - [`read_image`] picks the decoder by extension, checks header sizes against [`Limits`] (and
@@ -33,7 +33,6 @@ pub mod sanitize;
 pub mod scene_file;
 pub mod sh_file;
 pub mod texture;
-pub mod tonemap;
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -43,15 +42,13 @@ use ibl_core::{Image, Rgb};
 pub use error::{DecodeError, EncodeError, IoError};
 pub use exr::{ExrCompression, ExrOptions, ExrPrecision};
 pub use format::{ImageFormat, Limits, RawImage};
+use ibl_core::tonemap::{Display, to_srgb8};
 pub use light_export::{ExportError, ExportOptions, LightFormat, write_light_file};
 pub use mesh_file::{LoadedMesh, MeshLimits, read_mesh};
 pub use sanitize::{SanitizeReport, sanitize};
 pub use scene_file::{LoadedScene, read_scene};
 pub use sh_file::{ShFile, ShFileFormat, ShQuantity, read_sh_file, write_sh_file};
 pub use texture::{DecodedTexture, TexelFormat, Texture, TextureKind, TextureLevel};
-pub use tonemap::{Display, ToneCurve};
-
-use tonemap::to_srgb8;
 
 /// An image read from a file, with what reading did to it.
 #[derive(Clone, Debug, PartialEq)]
@@ -207,15 +204,11 @@ pub fn texture_of_image(image: &Image<Rgb>, kind: TextureKind) -> Result<Texture
 /// order, with the default [`Limits`]: `(file stem, image)` pairs. An error names the first file
 /// that cannot be read.
 pub fn read_images_in(dir: &Path, extension: &str) -> Result<Vec<(String, Image<Rgb>)>, IoError> {
-    let entries = std::fs::read_dir(dir).map_err(|e| IoError::read(dir, e))?;
-    let mut paths: Vec<PathBuf> = entries
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| {
-            p.extension()
-                .is_some_and(|x| x.eq_ignore_ascii_case(extension))
-        })
-        .collect();
-    paths.sort();
+    let mut paths = list_dir(dir)?;
+    paths.retain(|p| {
+        p.extension()
+            .is_some_and(|x| x.eq_ignore_ascii_case(extension))
+    });
     paths
         .into_iter()
         .map(|p| {
@@ -226,6 +219,43 @@ pub fn read_images_in(dir: &Path, extension: &str) -> Result<Vec<(String, Image<
             read_image(&p).map(|loaded| (name, loaded.image))
         })
         .collect()
+}
+
+/// Reads a whole file after checking its size against `max_bytes`.
+pub(crate) fn read_bounded(path: &Path, max_bytes: u64) -> Result<Vec<u8>, IoError> {
+    let len = std::fs::metadata(path)
+        .map_err(|e| IoError::read(path, e))?
+        .len();
+    if len > max_bytes {
+        return Err(IoError::Limits {
+            path: path.to_path_buf(),
+            what: format!("{len} bytes, over the limit of {max_bytes}"),
+        });
+    }
+    std::fs::read(path).map_err(|e| IoError::read(path, e))
+}
+
+/// Reads a UTF-8 text file of at most `max_bytes` (a list of exposure times, a response curve).
+pub fn read_text(path: &Path, max_bytes: u64) -> Result<String, IoError> {
+    let bytes = read_bounded(path, max_bytes)?;
+    String::from_utf8(bytes).map_err(|e| IoError::Invalid {
+        path: path.to_path_buf(),
+        reason: format!("not UTF-8 text: {e}"),
+    })
+}
+
+/// The entries of a folder, sorted by path. An unreadable or missing folder is
+/// [`IoError::Io`] (bad input when it does not exist).
+pub fn list_dir(dir: &Path) -> Result<Vec<PathBuf>, IoError> {
+    let entries = std::fs::read_dir(dir).map_err(|e| IoError::read(dir, e))?;
+    let mut paths: Vec<PathBuf> = entries.filter_map(|e| e.ok().map(|e| e.path())).collect();
+    paths.sort();
+    Ok(paths)
+}
+
+/// Creates a folder and its parents for outputs (nothing to do when it exists).
+pub fn create_dir_all(dir: &Path) -> Result<(), IoError> {
+    std::fs::create_dir_all(dir).map_err(|e| IoError::write(dir, e))
 }
 
 /// Reads an image file with the default [`Limits`].

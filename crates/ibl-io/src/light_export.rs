@@ -3,7 +3,7 @@
 //! light-set file of [`crate::light_file`]. [`LightFormat::from_path`] picks the format by
 //! extension and [`write_light_file`] writes any of them atomically.
 //!
-//! Every writer takes [`LightRecord`]s: `direction` is the unit vector **towards** the light (the
+//! Every writer takes [`Light`]s: `direction` is the unit vector **towards** the light (the
 //! file's frame preset, CONVENTIONS section 1; the writers never change axes, the caller picks the
 //! preset) and `irradiance` is `I = L A` per channel (CONVENTIONS section 4), the irradiance the
 //! light gives a surface facing it, in the probe's radiance unit x sr. A light *travels* along
@@ -41,7 +41,9 @@ use ibl_core::rgb::LUMINANCE_WEIGHTS;
 use serde_json::json;
 
 use crate::IoError;
-use crate::light_file::{LightRecord, LightsFile};
+use ibl_light::Light;
+
+use crate::light_file::LightsFile;
 
 /// Value of glTF's `asset.generator`.
 pub const GENERATOR: &str = concat!("iblkit ", env!("CARGO_PKG_VERSION"));
@@ -127,6 +129,11 @@ pub enum ExportError {
 }
 
 impl ExportError {
+    /// Always false: the lights came from our own extraction (see the type's doc).
+    pub fn is_bad_input(&self) -> bool {
+        false
+    }
+
     /// Attaches the file name; export failures are internal (`is_bad_input` is false).
     pub fn with_path(self, path: &Path) -> IoError {
         IoError::write(path, std::io::Error::other(self.to_string()))
@@ -160,13 +167,15 @@ impl ExportOptions {
     /// the source line.
     pub fn for_file(file: &LightsFile, lux_per_unit: f64) -> ExportOptions {
         ExportOptions {
-            frame: file.frame.clone(),
+            frame: file.frame.name().to_string(),
             source: format!(
-                "{} (sha256 {}), {}, {} lights",
-                file.probe.path,
-                file.probe.sha256,
-                file.method.name,
-                file.lights.len()
+                "{}, {}, {} lights",
+                file.set.provenance.probe.as_ref().map_or_else(
+                    || "probe not recorded".to_string(),
+                    |p| format!("{} (sha256 {})", p.path, p.sha256)
+                ),
+                file.set.provenance.extraction.name(),
+                file.set.lights.len()
             ),
             lux_per_unit,
         }
@@ -186,23 +195,23 @@ impl Checked {
     }
 }
 
-fn check(lights: &[LightRecord]) -> Result<Vec<Checked>, ExportError> {
+fn check(lights: &[Light]) -> Result<Vec<Checked>, ExportError> {
     lights
         .iter()
         .enumerate()
         .map(|(index, l)| {
             let bad = |what: String| ExportError::InvalidLight { index, what };
-            let d = DVec3::from_array(l.direction);
+            let d = l.direction;
             if !d.is_finite() || d.length() < 1e-9 {
                 return Err(bad(format!(
                     "direction {:?} is not a finite non-zero vector",
-                    l.direction
+                    d.to_array()
                 )));
             }
-            if l.irradiance.iter().any(|c| !c.is_finite() || *c < 0.0) {
+            let irradiance = l.irradiance.to_array();
+            if irradiance.iter().any(|c| !c.is_finite() || *c < 0.0) {
                 return Err(bad(format!(
-                    "irradiance {:?} is not finite and non-negative",
-                    l.irradiance
+                    "irradiance {irradiance:?} is not finite and non-negative"
                 )));
             }
             // Unit records are kept bit for bit; others are normalised.
@@ -213,7 +222,7 @@ fn check(lights: &[LightRecord]) -> Result<Vec<Checked>, ExportError> {
                 } else {
                     d / len
                 },
-                irradiance: l.irradiance,
+                irradiance,
             })
         })
         .collect()
@@ -266,10 +275,7 @@ fn light_name(index: usize) -> String {
 }
 
 /// The glTF 2.0 document as a JSON value.
-fn gltf_value(
-    lights: &[LightRecord],
-    options: &ExportOptions,
-) -> Result<serde_json::Value, ExportError> {
+fn gltf_value(lights: &[Light], options: &ExportOptions) -> Result<serde_json::Value, ExportError> {
     let s = options.lux_per_unit;
     if !(s.is_finite() && s > 0.0) {
         return Err(ExportError::LuxScale(s));
@@ -287,7 +293,7 @@ fn gltf_value(
             "extras": {
                 "irradiance": c.irradiance,
                 "illuminance_lux": s * luminance(c.irradiance),
-                "solid_angle": record.solid_angle,
+                "solid_angle": record.solid_angle_sr,
             },
         }));
         nodes.push(json!({
@@ -336,7 +342,7 @@ fn json_text(value: &serde_json::Value, pretty: bool) -> String {
 
 /// The lights as a glTF 2.0 JSON document (`.gltf`, pretty-printed): one directional
 /// `KHR_lights_punctual` light per record, each on its own node, all nodes in scene 0.
-pub fn gltf_json(lights: &[LightRecord], options: &ExportOptions) -> Result<String, ExportError> {
+pub fn gltf_json(lights: &[Light], options: &ExportOptions) -> Result<String, ExportError> {
     Ok(json_text(&gltf_value(lights, options)?, true))
 }
 
@@ -345,7 +351,7 @@ const GLB_JSON_CHUNK: u32 = 0x4E4F_534A;
 
 /// The lights as binary glTF (`.glb`): the 12-byte header (`glTF`, version 2, total length),
 /// then one JSON chunk padded with spaces to a multiple of 4 bytes; no binary chunk.
-pub fn glb(lights: &[LightRecord], options: &ExportOptions) -> Result<Vec<u8>, ExportError> {
+pub fn glb(lights: &[Light], options: &ExportOptions) -> Result<Vec<u8>, ExportError> {
     let mut chunk = json_text(&gltf_value(lights, options)?, false).into_bytes();
     chunk.resize(chunk.len().next_multiple_of(4), b' ');
     let total = 12 + 8 + chunk.len();
@@ -398,7 +404,7 @@ fn line_comment(text: &str) -> String {
 /// The lights as a Mitsuba 3 scene: `<scene version="3.0.0">` with one `directional` emitter per
 /// light (`direction` = travel direction, `irradiance` = `I` in the probe's unit); a comment
 /// states the frame. Load it as is or `<include>` it from another scene.
-pub fn mitsuba_xml(lights: &[LightRecord], options: &ExportOptions) -> Result<String, ExportError> {
+pub fn mitsuba_xml(lights: &[Light], options: &ExportOptions) -> Result<String, ExportError> {
     let checked = check(lights)?;
     let mut s = String::new();
     s.push_str("<?xml version=\"1.0\" encoding=\"utf-8\"?>\n");
@@ -439,7 +445,7 @@ pub fn mitsuba_xml(lights: &[LightRecord], options: &ExportOptions) -> Result<St
 /// The lights as a pbrt-v4 scene fragment: one `LightSource "distant"` per light (`from` = the
 /// direction towards the light, `to` = the origin, `"rgb L"` = `I`, `scale` 1), for `Include`
 /// after `WorldBegin`; comments state the frame and the units.
-pub fn pbrt_scene(lights: &[LightRecord], options: &ExportOptions) -> Result<String, ExportError> {
+pub fn pbrt_scene(lights: &[Light], options: &ExportOptions) -> Result<String, ExportError> {
     let checked = check(lights)?;
     let mut s = String::new();
     let _ = writeln!(
@@ -485,13 +491,11 @@ pub fn encode_light_file(
 ) -> Result<Vec<u8>, ExportError> {
     let options = ExportOptions::for_file(file, lux_per_unit);
     Ok(match format {
-        LightFormat::Json => serde_json::to_string_pretty(file)
-            .unwrap_or_default()
-            .into_bytes(),
-        LightFormat::Gltf => gltf_json(&file.lights, &options)?.into_bytes(),
-        LightFormat::Glb => glb(&file.lights, &options)?,
-        LightFormat::Mitsuba => mitsuba_xml(&file.lights, &options)?.into_bytes(),
-        LightFormat::Pbrt => pbrt_scene(&file.lights, &options)?.into_bytes(),
+        LightFormat::Json => file.to_json().into_bytes(),
+        LightFormat::Gltf => gltf_json(&file.set.lights, &options)?.into_bytes(),
+        LightFormat::Glb => glb(&file.set.lights, &options)?,
+        LightFormat::Mitsuba => mitsuba_xml(&file.set.lights, &options)?.into_bytes(),
+        LightFormat::Pbrt => pbrt_scene(&file.set.lights, &options)?.into_bytes(),
     })
 }
 
@@ -512,20 +516,22 @@ pub fn write_light_file(path: &Path, file: &LightsFile, lux_per_unit: f64) -> Re
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::light_file::{LIGHTS_FORMAT, MethodRef, ProbeRef};
+    use ibl_core::rgb::Rgb64;
+    use ibl_core::{FramePreset, Rgb};
+    use ibl_light::{Extraction, LightSet, ProbeRef, Provenance};
 
-    fn record(direction: [f64; 3], irradiance: [f64; 3]) -> LightRecord {
-        LightRecord {
-            direction,
-            radiance: [1.0; 3],
-            solid_angle: 0.01,
-            irradiance,
+    fn record(direction: [f64; 3], irradiance: [f64; 3]) -> Light {
+        Light {
+            direction: DVec3::from_array(direction),
+            radiance: Rgb::splat(1.0),
+            solid_angle_sr: 0.01,
+            irradiance: Rgb64::from_array(irradiance),
             region: None,
         }
     }
 
     /// Directions covering the degenerate cases (towards +-Z, the poles) and generic ones.
-    fn sample_lights() -> Vec<LightRecord> {
+    fn sample_lights() -> Vec<Light> {
         let dirs = [
             [0.0, 0.0, -1.0],
             [0.0, 0.0, 1.0],
@@ -558,7 +564,7 @@ mod tests {
         std::array::from_fn(|i| f(&v[i]))
     }
 
-    fn check_gltf(doc: &serde_json::Value, lights: &[LightRecord], lux: f64) {
+    fn check_gltf(doc: &serde_json::Value, lights: &[Light], lux: f64) {
         assert_eq!(doc["asset"]["version"], "2.0");
         assert!(
             doc["asset"]["generator"]
@@ -586,12 +592,12 @@ mod tests {
             let len = q.iter().map(|c| c * c).sum::<f64>().sqrt();
             assert!((len - 1.0).abs() < 1e-12, "{q:?}");
             let shines = rotate(q, DVec3::NEG_Z);
-            let want = -DVec3::from_array(l.direction);
+            let want = -l.direction;
             assert!((shines - want).length() < 1e-12, "{i}: {shines} vs {want}");
             let color: [f64; 3] = arr(&light["color"]);
             assert!(color.iter().all(|c| (0.0..=1.0).contains(c)), "{color:?}");
             let intensity = f(&light["intensity"]);
-            for (c, irradiance) in color.iter().zip(l.irradiance) {
+            for (c, irradiance) in color.iter().zip(l.irradiance.to_array()) {
                 let got = c * intensity;
                 let want = lux * irradiance;
                 assert!(
@@ -600,7 +606,7 @@ mod tests {
                 );
             }
             let y = luminance(color.map(|c| c * intensity));
-            assert!((y - lux * luminance(l.irradiance)).abs() < 1e-9);
+            assert!((y - lux * luminance(l.irradiance.to_array())).abs() < 1e-9);
             assert!((f(&light["extras"]["illuminance_lux"]) - y).abs() < 1e-9);
         }
     }
@@ -706,8 +712,8 @@ mod tests {
         assert_eq!((dirs.len(), irr.len()), (lights.len(), lights.len()));
         for (i, l) in lights.iter().enumerate() {
             for c in 0..3 {
-                assert_eq!(dirs[i][c], -l.direction[c]);
-                assert_eq!(irr[i][c], l.irradiance[c]);
+                assert_eq!(dirs[i][c], -l.direction.to_array()[c]);
+                assert_eq!(irr[i][c], l.irradiance.to_array()[c]);
             }
         }
     }
@@ -734,9 +740,9 @@ mod tests {
                 })
                 .collect();
             assert_eq!(groups.len(), 4, "{line}");
-            assert_eq!(groups[0], l.direction.to_vec());
+            assert_eq!(groups[0], l.direction.to_array().to_vec());
             assert_eq!(groups[1], vec![0.0; 3]);
-            assert_eq!(groups[2], l.irradiance.to_vec());
+            assert_eq!(groups[2], l.irradiance.to_array().to_vec());
             assert_eq!(groups[3], vec![1.0]);
         }
     }
@@ -821,19 +827,19 @@ mod tests {
     #[test]
     fn json_export_is_the_light_set_file() {
         let file = LightsFile {
-            format: LIGHTS_FORMAT.into(),
-            probe: ProbeRef {
-                path: "p.exr".into(),
-                width: 4,
-                height: 2,
-                sha256: "0".repeat(64),
+            set: LightSet {
+                provenance: Provenance {
+                    extraction: Extraction::MedianCut { splits: 3 },
+                    probe: Some(ProbeRef {
+                        path: "p.exr".into(),
+                        width: 4,
+                        height: 2,
+                        sha256: "0".repeat(64),
+                    }),
+                },
+                lights: sample_lights(),
             },
-            frame: "gltf".into(),
-            method: MethodRef {
-                name: "median-cut".into(),
-                parameters: json!({ "splits": 3 }),
-            },
-            lights: sample_lights(),
+            frame: FramePreset::Gltf,
             ambient: None,
         };
         let dir = tempfile::tempdir().expect("tempdir");
@@ -841,13 +847,12 @@ mod tests {
         write_light_file(&a, &file, 1.0).expect("writes");
         let back = crate::light_file::read_lights_file(&a).expect("reads");
         // serde_json's default float parser may differ from the written value in the last bit.
-        assert_eq!((&back.probe, &back.method), (&file.probe, &file.method));
-        assert_eq!(back.lights.len(), file.lights.len());
-        for (x, y) in back.lights.iter().zip(&file.lights) {
-            for c in 0..3 {
-                assert!((x.direction[c] - y.direction[c]).abs() < 1e-15);
-                assert_eq!(x.irradiance[c], y.irradiance[c]);
-            }
+        assert_eq!(back.set.provenance, file.set.provenance);
+        assert_eq!(back.set.lights.len(), file.set.lights.len());
+        for (x, y) in back.set.lights.iter().zip(&file.set.lights) {
+            // One f64 ulp of a unit component is 1.1e-16; 1e-15 allows a few.
+            assert!((x.direction - y.direction).abs().max_element() < 1e-15);
+            assert_eq!(x.irradiance, y.irradiance);
         }
         let b = dir.path().join("b.json");
         crate::light_file::write_lights_file(&b, &file).expect("writes");

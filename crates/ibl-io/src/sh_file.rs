@@ -33,7 +33,7 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use crate::IoError;
-use crate::light_file::ProbeRef;
+use ibl_light::ProbeRef;
 
 /// Value of the `format` field of iblkit's SH JSON.
 pub const SH_FORMAT: &str = "iblkit.sh/1";

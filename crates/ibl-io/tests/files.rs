@@ -7,11 +7,11 @@ mod common;
 use std::path::Path;
 
 use common::{bits, hdr_test_image, max_rel_error};
+use ibl_core::tonemap::{Display, ToneCurve, srgb_to_linear};
 use ibl_core::{Image, Rgb};
-use ibl_io::tonemap::srgb_to_linear;
 use ibl_io::{
-    Display, ExrOptions, ExrPrecision, ImageFormat, IoError, ToneCurve, WriteOptions,
-    ensure_output_is_not_input, read_image, write_image,
+    ExrOptions, ExrPrecision, ImageFormat, IoError, WriteOptions, ensure_output_is_not_input,
+    read_image, write_image,
 };
 
 fn leftovers(dir: &Path) -> Vec<String> {
@@ -123,6 +123,9 @@ fn png_output_uses_the_display_transform() {
     };
     write_image(&path, &img, &darker).expect("overwrites");
     let back = read_image(&path).expect("reads").image;
+    // Clamp at exposure -2: 4.0 maps to code 255, whose sRGB decoding is 1 to f32 rounding (1e-6);
+    // 1.0 maps to 0.25 exposed, whose 8-bit code decodes just under 0.26 (one 8-bit step there is
+    // 0.005).
     assert!((back.get(2, 0).r - 1.0).abs() < 1e-6 && back.get(0, 0).r < 0.26);
 }
 
@@ -149,7 +152,10 @@ fn png_input_variants_decode_to_linear() {
     let rgb16 = read_image(&p("rgb16.png")).expect("reads");
     assert!(rgb16.details.contains("16-bit RGB"), "{}", rgb16.details);
     let px = rgb16.image.get(3, 1);
+    // 16-bit codes decode through the exact sRGB EOTF in f32: equal to rounding (1e-7); 1e-6 is 16
+    // ulps.
     assert!((px.r - srgb_to_linear(60000.0 / 65535.0)).abs() < 1e-6 && px.g == 1.0);
+    // As above: the exact EOTF of 32768/65535, to f32 rounding.
     assert!((px.b - srgb_to_linear(32768.0 / 65535.0)).abs() < 1e-6);
     let grey = read_image(&p("grey8.png")).expect("reads");
     assert_eq!(

@@ -3,9 +3,9 @@
 
 use std::path::PathBuf;
 
+use ibl_core::tonemap::{Display, ToneCurve, auto_exposure_stops, to_srgb8};
 use ibl_core::{Image, Rgb};
-use ibl_io::tonemap::{auto_exposure_stops, to_srgb8};
-use ibl_io::{Display, ToneCurve, read_image};
+use ibl_io::read_image;
 
 fn one(v: f32, display: Display) -> [u8; 3] {
     *to_srgb8(&Image::filled(1, 1, Rgb::splat(v)), &display).get(0, 0)
@@ -108,17 +108,24 @@ fn auto_exposure_is_sane_on_a_probe() {
         .fold((0.0f64, 0u32), |(s, n), l| {
             (s + f64::from(l * scale).ln(), n + 1)
         });
+    // Automatic exposure maps the log-average luminance to 0.18: the exposure is kept in f32 stops
+    // (rounding 1e-7 relative) and the check re-sums f32 luminances; 1e-3 of 0.18 is far above
+    // both.
     assert!(((sum / f64::from(n)).exp() - 0.18).abs() < 1e-3);
     // A small sun 10^6 times brighter barely moves it; a black half does not move it at all.
     let mut sunny = probe.clone();
     for x in 0..4 {
         *sunny.get_mut(x, 10) = Rgb::splat(1e6);
     }
+    // Four 1e6 pixels among 131072 move the log average by about 4 ln(1e6) / 131072 = 4e-4 (6e-4
+    // stop); 0.1 stop is what a viewer would notice.
     assert!((auto_exposure_stops(&sunny) - stops).abs() < 0.1);
     let mut half_black = probe.clone();
     half_black.pixels_mut()[..512 * 128].fill(Rgb::ZERO);
     let lower_half_only =
         Image::from_vec(512, 128, probe.pixels()[512 * 128..].to_vec()).expect("half");
+    // Black pixels are left out of the log average: the two images average the same pixels, in a
+    // different order of f64 sums (1e-12); 1e-4 stop.
     assert!(
         (auto_exposure_stops(&half_black) - auto_exposure_stops(&lower_half_only)).abs() < 1e-4
     );

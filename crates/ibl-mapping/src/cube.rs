@@ -44,8 +44,9 @@
 use glam::DVec3;
 use ibl_core::{Image, Rgb};
 
-use crate::mapping::{CubeLayout, Mapping, MappingError};
-use crate::projection::{Taps, bilinear_corners};
+use crate::error::MappingError;
+use crate::mapping::{CubeLayout, Mapping};
+use crate::taps::{Taps, bilinear_corners};
 
 /// File-name suffixes of the six faces, in face order `+X, -X, +Y, -Y, +Z, -Z`.
 pub const CUBE_FACE_NAMES: [&str; 6] = ["px", "nx", "py", "ny", "pz", "nz"];

@@ -21,7 +21,8 @@ use glam::{DVec3, Vec3};
 use ibl_core::{Image, Rgb};
 
 use crate::cube::{CubeImage, dir_face, face_dir};
-use crate::mapping::{CubeLayout, MappingError};
+use crate::error::MappingError;
+use crate::mapping::CubeLayout;
 
 /// One level: six bordered faces of `(size + 2)^2` texels, face-major then row-major.
 #[derive(Clone, Debug)]

@@ -36,7 +36,7 @@ use std::f64::consts::{PI, TAU};
 
 use glam::DVec3;
 
-use crate::projection::{Taps, bilinear_corners};
+use crate::taps::{Taps, bilinear_corners};
 
 /// The radial law of a disc mapping.
 #[derive(Clone, Copy, Debug, PartialEq)]

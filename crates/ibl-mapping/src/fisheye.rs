@@ -29,7 +29,7 @@
 //! that [`crate::power()`] of a dual fisheye equals the power of the environment it shows.
 
 use crate::disc::{Disc, Profile, clipped_solid_angle};
-use crate::projection::Taps;
+use crate::taps::Taps;
 use glam::DVec3;
 
 /// `3x^2 - 2x^3` on [0, 1], clamped outside.

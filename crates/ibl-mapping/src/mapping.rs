@@ -16,10 +16,7 @@
 
 use std::fmt;
 
-use glam::DVec3;
-use ibl_core::Image;
-
-use crate::projection::Projection;
+pub use crate::error::MappingError;
 
 /// How the cells of a single-image cube map are arranged (see [`crate::cube`] for the exact cells
 /// and orientations). Six separate face files are handled with [`crate::split_cube_faces`] and
@@ -59,26 +56,6 @@ pub enum Mapping {
     },
 }
 
-/// Why a mapping cannot be used with an image or a parameter.
-#[derive(Debug, thiserror::Error)]
-pub enum MappingError {
-    /// The image size does not fit the mapping.
-    #[error("a {mapping} image cannot be {width} x {height}: {reason}")]
-    Shape {
-        /// The mapping's name.
-        mapping: String,
-        /// Image width.
-        width: usize,
-        /// Image height.
-        height: usize,
-        /// What the mapping needs.
-        reason: String,
-    },
-    /// A parameter (field of view, rotation matrix, size) is out of range.
-    #[error("{0}")]
-    Parameter(String),
-}
-
 /// The canonical names of every mapping, for help texts.
 pub const MAPPING_NAMES: [&str; 8] = [
     "latlong",
@@ -90,9 +67,6 @@ pub const MAPPING_NAMES: [&str; 8] = [
     "fisheye",
     "dual-fisheye",
 ];
-
-/// The largest all-zero image [`Mapping::texel_solid_angles`] returns for an invalid shape.
-const MAX_ZERO_PIXELS: usize = 1 << 28;
 
 /// Formats a field of view compactly: `195`, `190.5`.
 fn fov_text(fov: f32) -> String {
@@ -186,11 +160,6 @@ impl Mapping {
         }
     }
 
-    /// Whether a `width` x `height` image can hold this mapping (and its parameters are valid).
-    pub fn check_shape(&self, width: usize, height: usize) -> Result<(), MappingError> {
-        Projection::new(*self, width, height).map(|_| ())
-    }
-
     /// The output size for a requested width, adjusted to the mapping's shape: lat-long
     /// `2s x s` (s = width / 2), disc mappings `w x w`, horizontal cross `4s x 3s` (s = width / 4),
     /// vertical cross `3s x 4s` (s = width / 3), strip `6s x s` (s = width / 6), dual fisheye
@@ -249,47 +218,6 @@ impl Mapping {
             1
         };
         self.size_for_width(width)
-    }
-
-    /// The unit direction shown at continuous image coordinates `(x, y)` of a `width x height`
-    /// image (pixel (i, j)'s centre is `(i + 0.5, j + 0.5)`). `None` outside the valid domain:
-    /// outside the image, outside the disc, in an unused cross cell, or when the shape or
-    /// parameters are invalid.
-    pub fn pixel_dir(&self, width: usize, height: usize, x: f64, y: f64) -> Option<DVec3> {
-        let p = Projection::new(*self, width, height).ok()?;
-        p.pixel_dir(x, y).map(|(d, _)| d)
-    }
-
-    /// The continuous image coordinates showing direction `d` (need not be unit length); the
-    /// inverse of [`Mapping::pixel_dir`]. `None` for a zero or non-finite `d`, a direction a
-    /// fisheye does not see, or an invalid shape. For dual fisheye the lens with the larger
-    /// blend weight is chosen (the front lens on a tie).
-    pub fn dir_to_pixel(&self, width: usize, height: usize, d: DVec3) -> Option<(f64, f64)> {
-        let p = Projection::new(*self, width, height).ok()?;
-        if !d.is_finite() || d.length_squared() == 0.0 {
-            return None;
-        }
-        p.dir_to_pixel(d.normalize())
-    }
-
-    /// The solid angle (sr) of every pixel, 0 outside the domain. Exact closed forms: lat-long
-    /// rows (CONVENTIONS section 4), cube texels (`atan2(xy, sqrt(x^2 + y^2 + 1))` at the
-    /// corners), and disc texels clipped to the disc by Green's theorem (see [`crate::disc`]).
-    /// The total is 4 pi for every mapping that covers the sphere (to about 1e-12), `2 pi (1 -
-    /// cos(fov/2))` for a fisheye under 360 degrees. Dual fisheye counts every direction once:
-    /// each pixel's solid angle is weighted by its lens' blend weight (the same feathered weights
-    /// used when converting from dual fisheye), so the overlap of two lenses wider than 180
-    /// degrees is not counted twice. An invalid shape gives an all-zero image of the requested
-    /// size (0 x 0 beyond 2^28 pixels). Cost O(W H).
-    pub fn texel_solid_angles(&self, width: usize, height: usize) -> Image<f64> {
-        match Projection::new(*self, width, height) {
-            Ok(p) => p.texel_solid_angles(),
-            Err(_) => match width.checked_mul(height).filter(|&n| n <= MAX_ZERO_PIXELS) {
-                Some(n) => Image::from_vec(width, height, vec![0.0; n])
-                    .unwrap_or_else(|_| Image::from_fn_par(0, 0, |_, _| 0.0)),
-                None => Image::from_fn_par(0, 0, |_, _| 0.0),
-            },
-        }
     }
 }
 

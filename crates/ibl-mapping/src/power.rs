@@ -10,8 +10,9 @@
 use ibl_core::{Image, Rgb};
 use rayon::prelude::*;
 
-use crate::mapping::{Mapping, MappingError};
-use crate::projection::Projection;
+use crate::error::MappingError;
+use crate::mapping::Mapping;
+use crate::projection::{Geometry, Projection};
 
 /// Total power `sum L dOmega` per channel (sr x radiance units), f64. Returns `[NaN; 3]` when the
 /// image's shape does not fit `mapping` (use [`try_power`] to get the reason). Cost O(W H).
@@ -23,9 +24,9 @@ pub fn power(image: &Image<Rgb>, mapping: Mapping) -> [f64; 3] {
 pub fn try_power(image: &Image<Rgb>, mapping: Mapping) -> Result<[f64; 3], MappingError> {
     let projection = Projection::new(mapping, image.width(), image.height())?;
     let w = image.width();
-    let row_sums: Vec<[f64; 3]> = match projection {
+    let row_sums: Vec<[f64; 3]> = match projection.0 {
         // Lat-long: one solid angle per row, no per-pixel table needed.
-        Projection::LatLong(ll) => (0..image.height())
+        Geometry::LatLong(ll) => (0..image.height())
             .into_par_iter()
             .map(|j| scale(row_sum(image.row(j), None), ll.row_solid_angle(j)))
             .collect(),

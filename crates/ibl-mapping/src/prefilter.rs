@@ -1,6 +1,7 @@
 //! Engine-ready environment maps from one probe, in one call ([`prefilter`]): the GGX specular
-//! mip chain (cube and/or lat-long), the diffuse irradiance cube, spherical harmonics and the
-//! split-sum DFG table, what Filament's cmgen, cmft and the Khronos glTF-IBL-Sampler make.
+//! mip chain (cube and/or lat-long), the diffuse irradiance cube and the split-sum DFG table,
+//! what Filament's cmgen, cmft and the Khronos glTF-IBL-Sampler make (their spherical harmonics
+//! are `ibl-sh`'s; `ibl-pipeline::prefilter` adds them and writes the files).
 //!
 //! - **Specular** ([`crate::specular`]): level `m` of the chain has faces of `S / 2^m` and holds
 //!   the radiance prefiltered at the roughness the chosen [`EngineTarget`] reads at that level;
@@ -8,23 +9,21 @@
 //! - **Irradiance cube**: each texel is the exact irradiance at its centre direction divided by
 //!   pi, `E(n) / pi` (CONVENTIONS section 4; [`ibl_core::irradiance_exact`]), which is the
 //!   radiance of a white Lambertian surface: what engines multiply by the diffuse colour.
-//! - **SH**: the probe's radiance coefficients ([`ibl_sh::project_latlong`]); the exchange
-//!   formats are `ibl-io::sh_file`'s.
 //! - **DFG** ([`crate::dfg`]).
 //!
-//! Everything is in memory; writing files is the caller's (the CLI writes KTX2/DDS through
-//! `ibl-io`). The job reports progress as `(steps done, steps total)`, one step per output level
+//! Everything is in memory; writing files is the caller's (`ibl-pipeline` writes KTX2/DDS
+//! through `ibl-io`). The job reports progress as `(steps done, steps total)`, one step per output level
 //! or table.
 
 use ibl_core::{Image, Rgb};
-use ibl_sh::RadianceSh;
 
 use crate::cube::face_dir;
-use crate::cube_pyramid::CubePyramid;
 use crate::dfg::{Dfg, DfgLayout};
+use crate::error::MappingError;
 use crate::ggx::EngineTarget;
-use crate::mapping::{CubeLayout, Mapping, MappingError};
+use crate::mapping::{CubeLayout, Mapping};
 use crate::specular::{prefilter_cube, prefilter_latlong};
+use crate::specular_source::SpecularSource;
 use crate::{resample, split_cube_faces};
 
 /// Largest specular face size (a 4096 chain is 400 M texels of f32 RGB in memory).
@@ -67,8 +66,6 @@ pub struct PrefilterOptions {
     pub specular: Option<SpecularOptions>,
     /// Face size of the irradiance cube.
     pub irradiance_face: Option<usize>,
-    /// SH bands of the radiance projection.
-    pub sh_bands: Option<usize>,
     /// The DFG table.
     pub dfg: Option<DfgOptions>,
 }
@@ -93,8 +90,6 @@ pub struct Prefiltered {
     pub specular: Option<SpecularChain>,
     /// The irradiance cube `E / pi` (six faces, GL orientation).
     pub irradiance: Option<[Image<Rgb>; 6]>,
-    /// Radiance SH of the probe.
-    pub sh: Option<RadianceSh>,
     /// The DFG table.
     pub dfg: Option<Dfg>,
 }
@@ -160,14 +155,6 @@ pub fn check_options(options: &PrefilterOptions) -> Result<(), MappingError> {
     {
         return Err(parameter(format!(
             "the irradiance face size must be between 1 and {MAX_TABLE_SIZE}, got {f}"
-        )));
-    }
-    if let Some(b) = options.sh_bands
-        && !(1..=ibl_sh::MAX_BANDS).contains(&b)
-    {
-        return Err(parameter(format!(
-            "SH bands must be between 1 and {}, got {b}",
-            ibl_sh::MAX_BANDS
         )));
     }
     if let Some(d) = &options.dfg
@@ -246,7 +233,6 @@ pub fn prefilter(
     let total = levels
         + latlong_levels
         + usize::from(options.irradiance_face.is_some())
-        + usize::from(options.sh_bands.is_some())
         + usize::from(options.dfg.is_some());
     let mut done = 0;
     let mut step = || {
@@ -254,7 +240,6 @@ pub fn prefilter(
         progress(done, total);
     };
     let needs_latlong = options.irradiance_face.is_some()
-        || options.sh_bands.is_some()
         || options.specular.is_some_and(|s| s.latlong_width.is_some());
     let latlong = needs_latlong
         .then(|| latlong_of(probe, mapping))
@@ -262,7 +247,7 @@ pub fn prefilter(
     let mut out = Prefiltered::default();
 
     if let Some(s) = options.specular {
-        let source = CubePyramid::new(&cube_faces(probe, mapping, s.face_size)?)?;
+        let source = SpecularSource::new(&cube_faces(probe, mapping, s.face_size)?)?;
         let roughness: Vec<f64> = (0..levels)
             .map(|m| s.target.roughness(m, levels, s.face_size))
             .collect();
@@ -292,10 +277,6 @@ pub fn prefilter(
     }
     if let (Some(f), Some(ll)) = (options.irradiance_face, &latlong) {
         out.irradiance = Some(irradiance_cube(ll, f));
-        step();
-    }
-    if let (Some(bands), Some(ll)) = (options.sh_bands, &latlong) {
-        out.sh = Some(ibl_sh::project_latlong(ll, bands).map_err(|e| parameter(e.to_string()))?);
         step();
     }
     if let Some(d) = options.dfg {

@@ -1,5 +1,7 @@
-//! A [`Mapping`] bound to an image size: the per-sample geometry used by resampling, power and
-//! the public `Mapping` methods.
+//! A [`Mapping`] bound to an image size ([`Projection`]): the per-sample geometry used by
+//! resampling, power, the renderer and the viewer, so that every consumer samples any mapping
+//! the same way, and the `Mapping` methods that need it (`pixel_dir`, `dir_to_pixel`,
+//! `texel_solid_angles`, `check_shape`).
 //!
 //! Building a `Projection` validates the shape and parameters once (so no per-sample code can
 //! meet a zero size, a bad field of view or a cube layout that does not fit), then every query is
@@ -21,16 +23,22 @@
 use std::f64::consts::{PI, TAU};
 
 use glam::DVec3;
-use ibl_core::{Image, LatLong};
+use ibl_core::{Image, LatLong, Rgb};
 
 use crate::cube::{self, CubeImage};
 use crate::disc::{Disc, Profile};
+use crate::error::MappingError;
 use crate::fisheye::DualFisheye;
-use crate::mapping::{Mapping, MappingError};
+use crate::mapping::Mapping;
+use crate::taps::Taps;
 
-/// A mapping with a validated image size.
+/// A mapping with a validated image size: every query is O(1) and allocation-free.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) enum Projection {
+pub struct Projection(pub(crate) Geometry);
+
+/// The geometry of each kind of mapping.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Geometry {
     /// Equirectangular, any size.
     LatLong(LatLong),
     /// A single disc filling a square image (angular, mirror ball, fisheye).
@@ -52,7 +60,7 @@ fn shape(mapping: Mapping, width: usize, height: usize, reason: &str) -> Mapping
 
 impl Projection {
     /// Validates `mapping` for a `width x height` image.
-    pub(crate) fn new(mapping: Mapping, width: usize, height: usize) -> Result<Self, MappingError> {
+    pub fn new(mapping: Mapping, width: usize, height: usize) -> Result<Self, MappingError> {
         mapping.validate()?;
         if width == 0 || height == 0 {
             return Err(shape(mapping, width, height, "the image is empty"));
@@ -65,15 +73,15 @@ impl Projection {
         }
         let square = |profile: Profile, sz: f64| {
             if width == height {
-                Ok(Projection::Disc(Disc::new(
+                Ok(Projection(Geometry::Disc(Disc::new(
                     profile, 1.0, sz, 0, width, height,
-                )))
+                ))))
             } else {
                 Err(shape(mapping, width, height, "needs a square image"))
             }
         };
         match mapping {
-            Mapping::LatLong => Ok(Projection::LatLong(LatLong::new(width, height))),
+            Mapping::LatLong => Ok(Projection(Geometry::LatLong(LatLong::new(width, height)))),
             Mapping::Angular => square(Profile::Angular, -1.0),
             // The ball's centre looks at the camera (+Z).
             Mapping::MirrorBall => square(Profile::MirrorBall, 1.0),
@@ -85,10 +93,10 @@ impl Projection {
             ),
             Mapping::DualFisheye { fov_deg } => {
                 if width == 2 * height {
-                    Ok(Projection::Dual(DualFisheye::new(
+                    Ok(Projection(Geometry::Dual(DualFisheye::new(
                         height,
                         f64::from(fov_deg).to_radians() / 2.0,
-                    )))
+                    ))))
                 } else {
                     Err(shape(
                         mapping,
@@ -99,29 +107,29 @@ impl Projection {
                 }
             }
             Mapping::Cube(layout) => match layout.face_size(width, height) {
-                Some(size) => Ok(Projection::Cube(CubeImage::new(layout, size))),
+                Some(size) => Ok(Projection(Geometry::Cube(CubeImage::new(layout, size)))),
                 None => Err(cube::shape_error(layout, width, height)),
             },
         }
     }
 
     /// Image width in pixels.
-    pub(crate) fn width(&self) -> usize {
-        match self {
-            Projection::LatLong(ll) => ll.width,
-            Projection::Disc(d) => d.cw,
-            Projection::Dual(d) => 2 * d.front.cw,
-            Projection::Cube(c) => c.layout.grid().0 * c.size,
+    pub fn width(&self) -> usize {
+        match &self.0 {
+            Geometry::LatLong(ll) => ll.width,
+            Geometry::Disc(d) => d.cw,
+            Geometry::Dual(d) => 2 * d.front.cw,
+            Geometry::Cube(c) => c.layout.grid().0 * c.size,
         }
     }
 
     /// Image height in pixels.
-    pub(crate) fn height(&self) -> usize {
-        match self {
-            Projection::LatLong(ll) => ll.height,
-            Projection::Disc(d) => d.h,
-            Projection::Dual(d) => d.front.h,
-            Projection::Cube(c) => c.layout.grid().1 * c.size,
+    pub fn height(&self) -> usize {
+        match &self.0 {
+            Geometry::LatLong(ll) => ll.height,
+            Geometry::Disc(d) => d.h,
+            Geometry::Dual(d) => d.front.h,
+            Geometry::Cube(c) => c.layout.grid().1 * c.size,
         }
     }
 
@@ -131,27 +139,27 @@ impl Projection {
 
     /// Unit direction and solid-angle density (sr per unit pixel area) at continuous image
     /// coordinates; `None` outside the domain.
-    pub(crate) fn pixel_dir(&self, x: f64, y: f64) -> Option<(DVec3, f64)> {
+    pub fn pixel_dir(&self, x: f64, y: f64) -> Option<(DVec3, f64)> {
         if !self.inside_image(x, y) {
             return None;
         }
-        match self {
-            Projection::LatLong(ll) => {
+        match &self.0 {
+            Geometry::LatLong(ll) => {
                 let (w, h) = (ll.width as f64, ll.height as f64);
                 let v = y / h;
                 let density = (PI * v).sin() * (TAU / w) * (PI / h);
                 Some((LatLong::uv_to_dir64(x / w, v), density))
             }
-            Projection::Disc(d) => {
+            Geometry::Disc(d) => {
                 let (a, b) = d.disc_coords(x, y);
                 d.dir_density(a, b)
             }
-            Projection::Dual(dual) => {
+            Geometry::Dual(dual) => {
                 let lens = dual.lens_at(x);
                 let (a, b) = lens.disc_coords(x, y);
                 lens.dir_density(a, b)
             }
-            Projection::Cube(c) => c.dir_density(x, y),
+            Geometry::Cube(c) => c.dir_density(x, y),
         }
     }
 
@@ -163,9 +171,9 @@ impl Projection {
         if !self.inside_image(x, y) {
             return None;
         }
-        let lens = match self {
-            Projection::Disc(d) => d,
-            Projection::Dual(dual) => dual.lens_at(x),
+        let lens = match &self.0 {
+            Geometry::Disc(d) => d,
+            Geometry::Dual(dual) => dual.lens_at(x),
             _ => return self.pixel_dir(x, y).map(|(d, _)| d),
         };
         if !lens.texel_in_disc(i - lens.x0, j) {
@@ -176,23 +184,23 @@ impl Projection {
     }
 
     /// Continuous image coordinates of a unit direction; `None` where the mapping does not see it.
-    pub(crate) fn dir_to_pixel(&self, d: DVec3) -> Option<(f64, f64)> {
-        match self {
-            Projection::LatLong(ll) => {
+    pub fn dir_to_pixel(&self, d: DVec3) -> Option<(f64, f64)> {
+        match &self.0 {
+            Geometry::LatLong(ll) => {
                 let (u, v) = LatLong::dir_to_uv(d);
                 Some((u * ll.width as f64, v * ll.height as f64))
             }
-            Projection::Disc(disc) => disc.pixel_of_dir(d),
-            Projection::Dual(dual) => dual.pixel_of_dir(d),
-            Projection::Cube(c) => Some(c.pixel_of_dir(d)),
+            Geometry::Disc(disc) => disc.pixel_of_dir(d),
+            Geometry::Dual(dual) => dual.pixel_of_dir(d),
+            Geometry::Cube(c) => Some(c.pixel_of_dir(d)),
         }
     }
 
     /// A texel's solid angle near unit direction `d` (an estimate of the local resolution, used
     /// to choose the supersampling rate); 0 where the mapping does not see `d`.
     pub(crate) fn texel_solid_angle_near(&self, d: DVec3) -> f64 {
-        match self {
-            Projection::LatLong(ll) => {
+        match &self.0 {
+            Geometry::LatLong(ll) => {
                 let (_, v) = LatLong::dir_to_uv(d);
                 let row = ((v * ll.height as f64) as usize).min(ll.height - 1);
                 ll.row_solid_angle(row)
@@ -206,36 +214,46 @@ impl Projection {
 
     /// The source pixels and weights (summing to 1) that interpolate unit direction `d` (see
     /// the module note); empty where the mapping does not see `d`.
-    pub(crate) fn taps(&self, d: DVec3) -> Taps {
-        match self {
-            Projection::LatLong(ll) => latlong_taps(ll, d),
-            Projection::Disc(disc) => match disc.pixel_of_dir(d) {
+    pub fn taps(&self, d: DVec3) -> Taps {
+        match &self.0 {
+            Geometry::LatLong(ll) => latlong_taps(ll, d),
+            Geometry::Disc(disc) => match disc.pixel_of_dir(d) {
                 Some((x, y)) => disc.taps(disc.cw, x, y),
                 None => Taps::default(),
             },
-            Projection::Dual(dual) => dual.taps(2 * dual.front.cw, d),
-            Projection::Cube(c) => c.taps(d),
+            Geometry::Dual(dual) => dual.taps(2 * dual.front.cw, d),
+            Geometry::Cube(c) => c.taps(d),
         }
     }
 
     /// Exact solid angle of pixel `(i, j)` (see [`Mapping::texel_solid_angles`]).
-    pub(crate) fn texel_solid_angle(&self, i: usize, j: usize) -> f64 {
-        match self {
-            Projection::LatLong(ll) => ll.row_solid_angle(j),
-            Projection::Disc(d) => d.texel_solid_angle(i, j),
-            Projection::Dual(dual) => dual.texel_solid_angle(i, j),
-            Projection::Cube(c) => c.texel_solid_angle(i, j),
+    pub fn texel_solid_angle(&self, i: usize, j: usize) -> f64 {
+        match &self.0 {
+            Geometry::LatLong(ll) => ll.row_solid_angle(j),
+            Geometry::Disc(d) => d.texel_solid_angle(i, j),
+            Geometry::Dual(dual) => dual.texel_solid_angle(i, j),
+            Geometry::Cube(c) => c.texel_solid_angle(i, j),
         }
+    }
+
+    /// Bilinear radiance of `image` (this projection's size; black otherwise) towards unit
+    /// direction `d`: the [`Projection::taps`] gathered. Black where the mapping does not see
+    /// `d`.
+    pub fn sample(&self, image: &Image<Rgb>, d: DVec3) -> Rgb {
+        if (image.width(), image.height()) != (self.width(), self.height()) {
+            return Rgb::ZERO;
+        }
+        self.taps(d).gather(image.pixels())
     }
 
     /// Exact solid angles of every pixel, rows in parallel; disc images compute one quadrant and
     /// mirror it (the disc is symmetric about both axes of the cell). Cost O(W H).
-    pub(crate) fn texel_solid_angles(&self) -> Image<f64> {
+    pub fn texel_solid_angles(&self) -> Image<f64> {
         let (w, h) = (self.width(), self.height());
-        match self {
-            Projection::Disc(_) | Projection::Dual(_) => {
+        match &self.0 {
+            Geometry::Disc(_) | Geometry::Dual(_) => {
                 // Mirror within the cell: column i of a cell of width cw equals column cw-1-i.
-                let cw = if let Projection::Dual(d) = self {
+                let cw = if let Geometry::Dual(d) = &self.0 {
                     d.front.cw
                 } else {
                     w
@@ -277,68 +295,54 @@ fn latlong_taps(ll: &LatLong, d: DVec3) -> Taps {
     taps
 }
 
-/// The four bilinear corners `(column, row, weight)` of continuous texel coordinates `(fx, fy)`
-/// (texel centres at integers), clamped to a `width` x `height` grid.
-pub(crate) fn bilinear_corners(
-    fx: f64,
-    fy: f64,
-    width: usize,
-    height: usize,
-) -> [(usize, usize, f64); 4] {
-    let fx = fx.clamp(0.0, width.saturating_sub(1) as f64);
-    let fy = fy.clamp(0.0, height.saturating_sub(1) as f64);
-    let (i0, j0) = (fx.floor() as usize, fy.floor() as usize);
-    let (tx, ty) = (fx - i0 as f64, fy - j0 as f64);
-    let i1 = (i0 + 1).min(width.saturating_sub(1));
-    let j1 = (j0 + 1).min(height.saturating_sub(1));
-    [
-        (i0, j0, (1.0 - tx) * (1.0 - ty)),
-        (i1, j0, tx * (1.0 - ty)),
-        (i0, j1, (1.0 - tx) * ty),
-        (i1, j1, tx * ty),
-    ]
-}
+/// The largest all-zero image [`Mapping::texel_solid_angles`] returns for an invalid shape.
+const MAX_ZERO_PIXELS: usize = 1 << 28;
 
-/// Up to eight (pixel index, weight) pairs: a bilinear look-up, or two blended ones.
-#[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct Taps {
-    idx: [usize; 8],
-    w: [f64; 8],
-    n: usize,
-}
+impl Mapping {
+    /// Whether a `width` x `height` image can hold this mapping (and its parameters are valid).
+    pub fn check_shape(&self, width: usize, height: usize) -> Result<(), MappingError> {
+        Projection::new(*self, width, height).map(|_| ())
+    }
 
-impl Taps {
-    /// Adds a tap (ignored beyond eight).
-    pub(crate) fn push(&mut self, idx: usize, w: f64) {
-        if self.n < 8 {
-            self.idx[self.n] = idx;
-            self.w[self.n] = w;
-            self.n += 1;
+    /// The unit direction shown at continuous image coordinates `(x, y)` of a `width x height`
+    /// image (pixel (i, j)'s centre is `(i + 0.5, j + 0.5)`). `None` outside the valid domain:
+    /// outside the image, outside the disc, in an unused cross cell, or when the shape or
+    /// parameters are invalid.
+    pub fn pixel_dir(&self, width: usize, height: usize, x: f64, y: f64) -> Option<DVec3> {
+        let p = Projection::new(*self, width, height).ok()?;
+        p.pixel_dir(x, y).map(|(d, _)| d)
+    }
+
+    /// The continuous image coordinates showing direction `d` (need not be unit length); the
+    /// inverse of [`Mapping::pixel_dir`]. `None` for a zero or non-finite `d`, a direction a
+    /// fisheye does not see, or an invalid shape. For dual fisheye the lens with the larger
+    /// blend weight is chosen (the front lens on a tie).
+    pub fn dir_to_pixel(&self, width: usize, height: usize, d: DVec3) -> Option<(f64, f64)> {
+        let p = Projection::new(*self, width, height).ok()?;
+        if !d.is_finite() || d.length_squared() == 0.0 {
+            return None;
         }
+        p.dir_to_pixel(d.normalize())
     }
 
-    /// Whether there are no taps.
-    pub(crate) fn is_empty(&self) -> bool {
-        self.n == 0
-    }
-
-    /// The taps with weights scaled to sum to 1 (unchanged if they sum to 0).
-    pub(crate) fn normalised(mut self) -> Self {
-        let sum: f64 = self.w[..self.n].iter().sum();
-        if sum > 0.0 {
-            for w in &mut self.w[..self.n] {
-                *w /= sum;
-            }
+    /// The solid angle (sr) of every pixel, 0 outside the domain. Exact closed forms: lat-long
+    /// rows (CONVENTIONS section 4), cube texels (`atan2(xy, sqrt(x^2 + y^2 + 1))` at the
+    /// corners), and disc texels clipped to the disc by Green's theorem (see [`crate::disc`]).
+    /// The total is 4 pi for every mapping that covers the sphere (to about 1e-12), `2 pi (1 -
+    /// cos(fov/2))` for a fisheye under 360 degrees. Dual fisheye counts every direction once:
+    /// each pixel's solid angle is weighted by its lens' blend weight (the same feathered weights
+    /// used when converting from dual fisheye), so the overlap of two lenses wider than 180
+    /// degrees is not counted twice. An invalid shape gives an all-zero image of the requested
+    /// size (0 x 0 beyond 2^28 pixels). Cost O(W H).
+    pub fn texel_solid_angles(&self, width: usize, height: usize) -> Image<f64> {
+        match Projection::new(*self, width, height) {
+            Ok(p) => p.texel_solid_angles(),
+            Err(_) => match width.checked_mul(height).filter(|&n| n <= MAX_ZERO_PIXELS) {
+                Some(n) => Image::from_vec(width, height, vec![0.0; n])
+                    .unwrap_or_else(|_| Image::from_fn_par(0, 0, |_, _| 0.0)),
+                None => Image::from_fn_par(0, 0, |_, _| 0.0),
+            },
         }
-        self
-    }
-
-    /// The `(index, weight)` pairs.
-    pub(crate) fn iter(&self) -> impl Iterator<Item = (usize, f64)> + '_ {
-        self.idx[..self.n]
-            .iter()
-            .copied()
-            .zip(self.w[..self.n].iter().copied())
     }
 }
 

@@ -52,8 +52,9 @@ use glam::{DMat3, DVec3, Mat3};
 use ibl_core::{Image, Rgb};
 use rayon::prelude::*;
 
-use crate::mapping::{Mapping, MappingError};
-use crate::projection::Projection;
+use crate::error::MappingError;
+use crate::mapping::Mapping;
+use crate::projection::{Geometry, Projection};
 
 /// Sub-samples per axis per destination pixel per source texel, and the most per axis.
 const RATE: (f64, usize) = (2.0, 16);
@@ -281,7 +282,7 @@ impl Job<'_> {
         };
         let sample = |g: &mut Gathered, d: DVec3, w: f64| self.add_sample(g, d, w);
         let (step_x, step_y) = (1.0 / kx as f64, 1.0 / ky as f64);
-        if let Projection::LatLong(ll) = self.dest {
+        if let Geometry::LatLong(ll) = self.dest.0 {
             // Separable: theta per sub-row, phi per sub-column (the formula of LatLong).
             let (w, h) = (ll.width as f64, ll.height as f64);
             let mut cols = [(0.0, 0.0); HOT_RATE.1];

@@ -10,6 +10,10 @@ use ibl_core::glam::DVec3;
 use ibl_core::{Image, Rgb};
 use ibl_mapping::{CUBE_FACE_NAMES, CubeLayout, Mapping, split_cube_faces};
 
+/// Whether `a` and `b` agree to `tol` in every component. The tolerances used: 1e-12 where a
+/// formula of CONVENTIONS is evaluated in f64 through a few trigonometric functions (each exact
+/// to an ulp or two of 1, 2.2e-16, so 1e-12 is a margin of a few thousand), 1e-4 for the
+/// four-digit test vectors the document prints.
 fn close(a: DVec3, b: DVec3, tol: f64) -> bool {
     (a - b).abs().max_element() <= tol
 }
@@ -64,10 +68,13 @@ fn latlong_test_vectors() {
 fn latlong_inverse_matches_the_formula() {
     let ll = Mapping::LatLong;
     let (x, y) = ll.dir_to_pixel(512, 256, DVec3::X).unwrap();
+    // Pixel coordinates of an exact direction: u W and v H in f64 through atan2 and acos, a few
+    // ulps of 512 (1e-13); 1e-9.
     assert!((x - 384.0).abs() < 1e-9 && (y - 128.0).abs() < 1e-9);
     let (x, y) = ll
         .dir_to_pixel(512, 256, DVec3::new(0.0, 0.0, -3.0))
         .unwrap();
+    // As above: f64 rounding of coordinates of order 256.
     assert!((x - 256.0).abs() < 1e-9 && (y - 128.0).abs() < 1e-9);
     assert!(ll.dir_to_pixel(512, 256, DVec3::ZERO).is_none());
     assert!(
@@ -121,6 +128,7 @@ fn latlong_poles() {
     for pole in [DVec3::Y, DVec3::NEG_Y] {
         let (x, y) = ll.dir_to_pixel(512, 256, pole).unwrap();
         assert!(x.is_finite() && (0.0..=512.0).contains(&x));
+        // The poles map to the top and bottom edges exactly but for acos rounding: 1e-9 pixel.
         assert!((y - if pole.y > 0.0 { 0.0 } else { 256.0 }).abs() < 1e-9);
     }
 }
@@ -232,12 +240,17 @@ fn mirror_ball_is_equal_area() {
     let omega = Mapping::MirrorBall.texel_solid_angles(n, n);
     let inner = *omega.get(50, 50);
     assert!((inner - 16.0 / (n * n) as f64).abs() < 1e-15);
+    // Equal-area by construction: every inner texel's solid angle is the same closed form, to f64
+    // rounding (1e-18 for values of 1.6e-3); 1e-15.
     assert!((*omega.get(30, 70) - inner).abs() < 1e-15);
     // Angular: dOmega = pi sin(pi r) / r da db, checked at a pixel centre by a fine midpoint sum.
     let omega = Mapping::Angular.texel_solid_angles(n, n);
     let (a, b) = disc_ab(70, 40, n, n);
     let r = (a * a + b * b).sqrt();
     let approx = PI * (PI * r).sin() / r * 4.0 / (n * n) as f64;
+    // The exact texel integral against a one-point midpoint rule: they differ by the variation of
+    // sin(pi r) / r across one texel (second order in the texel size 0.02 of the disc), far under
+    // 1e-3.
     assert!((*omega.get(70, 40) / approx - 1.0).abs() < 1e-3);
 }
 
@@ -317,6 +330,7 @@ fn latlong_row_solid_angles_sum_to_4pi() {
     for (w, h) in [(512, 256), (2048, 1024), (7, 3), (1, 1)] {
         let omega = Mapping::LatLong.texel_solid_angles(w, h);
         let sum: f64 = omega.pixels().iter().sum();
+        // Exact row solid angles summed over every row: 4 pi to f64 rounding (1e-13); 1e-9.
         assert!((sum - 4.0 * PI).abs() < 1e-9, "{w} x {h}: {sum}");
         // Exact row formula of CONVENTIONS section 4.
         let j = h / 3;
@@ -343,6 +357,8 @@ fn texel_solid_angles_sum_to_4pi() {
         let omega = m.texel_solid_angles(w, h);
         assert_eq!((omega.width(), omega.height()), (w, h));
         let sum: f64 = omega.pixels().iter().sum();
+        // Exact closed forms (rows, cube corners, disc texels clipped by Green's theorem): 4 pi to
+        // f64 rounding over up to a million texels (1e-12 relative); 1e-9.
         assert!(
             (sum / (4.0 * PI) - 1.0).abs() < 1e-9,
             "{} {w} x {h}: {sum}",
@@ -359,6 +375,7 @@ fn texel_solid_angles_sum_to_4pi() {
             .pixels()
             .iter()
             .sum();
+        // As above for a fisheye's cap.
         assert!(
             (single / cap - 1.0).abs() < 1e-9,
             "fisheye {fov}: {single} vs {cap}"
@@ -371,6 +388,7 @@ fn texel_solid_angles_sum_to_4pi() {
         .pixels()
         .iter()
         .sum();
+    // As above for two caps.
     assert!((dual / (4.0 * PI * (1.0 - half.cos())) - 1.0).abs() < 1e-9);
     // Outside the disc and in unused cross cells: 0.
     assert_eq!(*Mapping::Angular.texel_solid_angles(64, 64).get(0, 0), 0.0);
@@ -467,6 +485,7 @@ fn cube_faces_follow_the_gl_table() {
             let (col, row, _) = layout.cell(f);
             let (x, y) = m.dir_to_pixel(w, h, *axis).unwrap();
             assert!((x - (col as f64 + 0.5) * s as f64).abs() < 1e-9);
+            // A face centre's pixel coordinates: f64 rounding of s (c + 0.5) (1e-13); 1e-9.
             assert!((y - (row as f64 + 0.5) * s as f64).abs() < 1e-9);
         }
     }
@@ -524,6 +543,9 @@ fn cube_edges_match_across_the_layouts() {
                         let y = (r * s) as f64 + k as f64 + 0.5;
                         let a = m.pixel_dir(w, h, x - eps, y).unwrap();
                         let b = m.pixel_dir(w, h, x + eps, y).unwrap();
+                        // Across a cell edge the directions are continuous: the two sides are 2 eps
+                        // = 2e-9 pixel apart, a few 1e-11 rad on these faces; 1e-6 rad still flags
+                        // any fold mistake (which jumps by a right angle).
                         assert!(
                             a.angle_between(b) < 1e-6,
                             "{layout:?} ({c},{r})|({},{r}) k={k}",
@@ -539,6 +561,7 @@ fn cube_edges_match_across_the_layouts() {
                         let x = (c * s) as f64 + k as f64 + 0.5;
                         let a = m.pixel_dir(w, h, x, y - eps).unwrap();
                         let b = m.pixel_dir(w, h, x, y + eps).unwrap();
+                        // As above across the edge below.
                         assert!(
                             a.angle_between(b) < 1e-6,
                             "{layout:?} ({c},{r}) over ({c},{})",
@@ -563,6 +586,8 @@ fn cube_cross_wraps_around_the_horizon() {
         let y = s + k as f64 + 0.5;
         let right_end = m.pixel_dir(128, 96, 128.0, y).unwrap();
         let left_end = m.pixel_dir(128, 96, 0.0, y).unwrap();
+        // The cross's row closes on itself: both ends show the same direction but for f64 rounding
+        // (1e-15 rad); 1e-9.
         assert!(right_end.angle_between(left_end) < 1e-9);
     }
 }
@@ -579,9 +604,12 @@ fn pixel_dir_and_dir_to_pixel_are_inverse() {
                 let Some(d) = m.pixel_dir(w, h, x, y) else {
                     continue;
                 };
+                // Every pixel direction is a normalised f64 vector: unit to a few ulps.
                 assert!((d.length() - 1.0).abs() < 1e-12);
                 let (x2, y2) = m.dir_to_pixel(w, h, d).unwrap();
                 let d2 = m.pixel_dir(w, h, x2, y2).unwrap();
+                // pixel_dir(dir_to_pixel(d)) = d up to f64 rounding of the forward and inverse
+                // formulas (1e-14); 1e-12.
                 assert!((d - d2).length() < 1e-12, "{} ({i}, {j})", m.name());
                 n += 1;
             }

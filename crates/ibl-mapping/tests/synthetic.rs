@@ -93,6 +93,9 @@ fn constant_environment_stays_constant_in_every_mapping() {
                 let v = *out.get(i, j);
                 if *omega.get(i, j) > 0.0 {
                     for k in 0..3 {
+                        // A constant environment resamples to the constant: every output texel is a
+                        // normalised weighted mean of equal values, exact but for f32 accumulation
+                        // over up to a few hundred sub-samples (1e-5 relative); 1e-4.
                         assert!(
                             (v[k] / c[k] - 1.0).abs() < 1e-4,
                             "{} ({i}, {j}) {v:?}",
@@ -121,6 +124,8 @@ fn constant_environment_stays_constant_in_every_mapping() {
             let full = Image::filled(w, h, c);
             let ll = resample(&full, m, Mapping::LatLong, 64, 32, r, &quiet).unwrap();
             for v in ll.pixels() {
+                // As above, through a rotation: normalised means of equal values, f32 accumulation
+                // only.
                 assert!(
                     (v.g / c.g - 1.0).abs() < 1e-4,
                     "{} -> latlong {v:?}",
@@ -151,6 +156,8 @@ fn fisheye_sees_only_its_field_of_view() {
             let d = grid.pixel_dir64(i, j);
             let v = ll.get(i, j).g;
             if d.z < -0.1 {
+                // Inside the fisheye's view the constant comes back as a normalised mean of equal
+                // values (f32 accumulation, 1e-5); 1e-4.
                 assert!((v - 1.0).abs() < 1e-4, "({i}, {j}) in view");
             } else if d.z > 0.1 {
                 assert_eq!(v, 0.0, "({i}, {j}) behind the lens");
@@ -178,6 +185,9 @@ fn smooth_fields_land_on_their_directions() {
                 let d = m.pixel_dir(w, h, i as f64 + 0.5, j as f64 + 0.5).unwrap();
                 let (got, want) = (*out.get(i, j), field(d));
                 for k in 0..3 {
+                    // A smooth field (values of order 1) resampled by area averaging: the texel
+                    // mean differs from the centre value by the field's curvature times the texel
+                    // size squared, about 1e-3 at these sizes; 0.01.
                     assert!(
                         (got[k] - want[k]).abs() < 0.01,
                         "{} ({i}, {j}) {got:?} {want:?}",
@@ -252,6 +262,8 @@ fn yaw_90_moves_forward_to_the_left() {
     }
     .world_from_probe();
     let src = sun_env(256, 128, DVec3::NEG_Z, 2.0, 1000.0);
+    // The sun (2 degrees across) is found at the brightest texel: within one texel of its centre
+    // (256 x 128: 1.4 degrees, 0.025 rad); 0.03 rad.
     assert!(brightest(&src, Mapping::LatLong).angle_between(DVec3::NEG_Z) < 0.03);
     let turned = rotate(&src, Mapping::LatLong, yaw, &quiet).unwrap();
     assert!(brightest(&turned, Mapping::LatLong).angle_between(DVec3::NEG_X) < 0.03);
@@ -260,6 +272,7 @@ fn yaw_90_moves_forward_to_the_left() {
     // The same through a cube map and while converting.
     let cube = Mapping::Cube(CubeLayout::HorizontalCross);
     let c = resample(&src, Mapping::LatLong, cube, 256, 192, yaw, &quiet).unwrap();
+    // One texel of the cube's 64-texel faces is about 0.03 rad at face centre; 0.03 rad.
     assert!(brightest(&c, cube).angle_between(DVec3::NEG_X) < 0.03);
     let c2 = rotate(&c, cube, yaw, &quiet).unwrap();
     assert!(
@@ -411,13 +424,19 @@ fn dual_fisheye_seam_is_feathered() {
         let half = 100f64.to_radians();
         let c_front = -d.z;
         if c_front > -half.cos() + 1e-2 && c_front > half.cos().abs() + 1e-2 {
+            // Away from the overlap only one lens contributes: the constant 1 (front) or 3 (back)
+            // as a normalised mean, f32 accumulation (1e-5); 1e-3.
             assert!((v - 1.0).abs() < 1e-3, "{i}: front only");
         }
         if -c_front > half.cos().abs() + 1e-2 {
             assert!((v - 3.0).abs() < 1e-3, "{i}: back only");
         }
         if let Some(prev) = last {
+            // The feathered blend is monotonic in the angle: consecutive samples may only fall by
+            // f32 noise (1e-5); 1e-4.
             assert!(v >= prev - 1e-4, "monotonic at {i}");
+            // The blend spreads 1 -> 3 over the overlap (about 180 columns): a step of about 0.02
+            // per column, far below 0.1 (a hard seam would jump by 2).
             assert!(v - prev < 0.1, "no jump at {i}");
         }
         last = Some(v);
@@ -430,6 +449,9 @@ fn dual_fisheye_seam_is_feathered() {
     let w_front = x * x * (3.0 - 2.0 * x);
     let expect = w_front + 3.0 * (1.0 - w_front);
     let v = f64::from(ll.get(540, row).g);
+    // The blend weight at column 540 from the smoothstep formula: the resampled value is a
+    // normalised mean of the blend over the texel (curvature error of order 1e-4); 1e-3. It is
+    // about half way, 2 +- 0.05.
     assert!(
         (v - expect).abs() < 1e-3 && (v - 2.0).abs() < 0.05,
         "{v} vs {expect}"
@@ -452,6 +474,8 @@ fn cube_layouts_hold_the_same_faces() {
         let a = resample(&cross, h, Mapping::LatLong, 128, 64, Mat3::IDENTITY, &quiet).unwrap();
         let b = resample(&other, m, Mapping::LatLong, 128, 64, Mat3::IDENTITY, &quiet).unwrap();
         assert_eq!(a, b, "{layout:?}");
+        // The same face texels in another layout: the same power sum, in another order of f64 sums
+        // (1e-15 relative of a power of order 1); 1e-12.
         assert!((power(&cross, h)[0] - power(&other, m)[0]).abs() < 1e-12);
     }
 }
@@ -533,6 +557,8 @@ fn bad_input_gives_errors_not_panics() {
         let out = resample(&ll, Mapping::LatLong, m, w, h, id, &quiet).unwrap();
         assert!(out.pixels().iter().all(|c| c.is_valid_radiance()));
         let back = resample(&out, m, Mapping::LatLong, 8, 4, id, &quiet).unwrap();
+        // A constant through a 1 x 1 / 4 x 3 map and back: normalised means of equal values, f32
+        // accumulation (1e-6); 1e-4.
         assert!(
             back.pixels().iter().all(|c| (c.g - 1.0).abs() < 1e-4),
             "{}",

@@ -13,7 +13,8 @@ use std::hint::black_box;
 use std::path::Path;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use ibl_extract::{ExtractOptions, Method, extract};
+use ibl_extract::{ExtractOptions, extract};
+use ibl_light::Method;
 use ibl_render::lighting::Lighting;
 use ibl_render::{RenderSettings, render};
 use ibl_scene::description::CompositeRule;
@@ -60,8 +61,7 @@ fn bench_differential(c: &mut Criterion) {
         64,
         &ExtractOptions::default(),
     )
-    .expect("lights")
-    .set;
+    .expect("lights");
     let lighting = Lighting::lights(&scene, &lights, ShadowKind::Hard).expect("lighting");
     let settings = RenderSettings {
         composite: CompositeRule::Difference,

@@ -68,6 +68,13 @@ pub enum EnvironmentError {
     InvalidScale(f32),
 }
 
+impl EnvironmentError {
+    /// Always true: the probe, its rotation and its scale come from the scene.
+    pub fn is_bad_input(&self) -> bool {
+        true
+    }
+}
+
 /// One direction drawn from [`EnvironmentLight::sample`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EnvSample {

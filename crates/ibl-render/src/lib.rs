@@ -30,7 +30,15 @@ pub enum RenderError {
     /// The probe cannot be used as an environment light.
     #[error("the probe cannot light the scene: {0}")]
     Environment(#[from] environment::EnvironmentError),
-    /// The lights cannot be made.
-    #[error("extracting the lights: {0}")]
-    Extract(#[from] ibl_extract::ExtractError),
+}
+
+impl RenderError {
+    /// Whether the scene or the settings the caller gave are at fault: always, since a render
+    /// fails only on a setting out of range or a probe that cannot light (black, empty); the
+    /// renderer has no internal failure that returns.
+    pub fn is_bad_input(&self) -> bool {
+        match self {
+            RenderError::Parameter(_) | RenderError::Environment(_) => true,
+        }
+    }
 }

@@ -6,7 +6,7 @@
 //!   its direction) or soft shadows (shadow rays spread uniformly over a cone of the light's own
 //!   solid angle `A_i`, half-angle `acos(1 - A_i / 2 pi)`);
 //! - **hybrid**: the important lights with shadows plus an SH ambient (the probe minus the lights,
-//!   `ibl_extract::Hybrid`) whose irradiance is attenuated by ambient occlusion.
+//!   as `ibl_extract::Hybrid` makes it) whose irradiance is attenuated by ambient occlusion.
 //!
 //! In every mode the environment is still what a perfect mirror reflects and what the camera sees
 //! where it sees no geometry; only diffuse and glossy reflection use the approximation. Lights come
@@ -14,9 +14,9 @@
 
 use glam::{DMat3, Vec3};
 use ibl_core::Rgb;
-use ibl_extract::{Hybrid, LightSet};
+use ibl_light::LightSet;
 use ibl_scene::{Scene, ShadowKind};
-use ibl_sh::IrradianceSh;
+use ibl_sh::{IrradianceSh, RadianceSh};
 
 use crate::environment::{EnvironmentError, EnvironmentLight};
 use crate::sampling::{Distribution1D, UniformCone};
@@ -102,10 +102,12 @@ impl Lighting {
         })
     }
 
-    /// `hybrid` mode: `hybrid` (lights + SH ambient) is in the probe's frame.
+    /// `hybrid` mode: the lights `set` and the `ambient` radiance (the probe minus the lights, in
+    /// SH) are in the probe's frame.
     pub fn hybrid(
         scene: &Scene,
-        hybrid: &Hybrid,
+        set: &LightSet,
+        ambient: &RadianceSh,
         window: ibl_sh::Window,
         shadows: ShadowKind,
         occlusion_rays: u32,
@@ -114,9 +116,9 @@ impl Lighting {
         Ok(Lighting {
             environment: Self::environment(scene)?,
             illumination: Illumination::Hybrid(
-                light_list(scene, &hybrid.lights, shadows),
+                light_list(scene, set, shadows),
                 Ambient {
-                    irradiance: hybrid.ambient.rotated(rotation).irradiance(window),
+                    irradiance: ambient.rotated(rotation).irradiance(window),
                     occlusion_rays: occlusion_rays.max(1),
                 },
             ),
@@ -129,13 +131,13 @@ fn light_list(scene: &Scene, set: &LightSet, shadows: ShadowKind) -> LightList {
     let lights: Vec<DirectionalLight> = set
         .lights
         .iter()
-        .filter(|l| l.irradiance.iter().any(|&c| c > 0.0))
+        .filter(|l| l.irradiance.any_positive())
         .map(|l| DirectionalLight {
-            direction: (rotation * l.dir()).normalize().as_vec3(),
+            direction: (rotation * l.direction).normalize().as_vec3(),
             irradiance: Rgb::new(
-                l.irradiance[0] as f32,
-                l.irradiance[1] as f32,
-                l.irradiance[2] as f32,
+                l.irradiance.r as f32,
+                l.irradiance.g as f32,
+                l.irradiance.b as f32,
             ),
             cone: UniformCone::from_solid_angle(l.solid_angle_sr as f32),
         })
@@ -145,91 +147,5 @@ fn light_list(scene: &Scene, set: &LightSet, shadows: ShadowKind) -> LightList {
         lights,
         shadows,
         choice,
-    }
-}
-
-/// The lighting a render asks for: the mode and, for `lights` and `hybrid`, where the lights
-/// come from (the scene's `[lighting]` table with any command-line overrides applied).
-#[derive(Clone, Debug, PartialEq)]
-pub struct LightingPlan {
-    /// The mode.
-    pub mode: ibl_scene::RenderMode,
-    /// Extraction model name: a method (`median-cut`, ...) or `sun` (the dominant light).
-    pub method: String,
-    /// Number of lights to extract.
-    pub lights: usize,
-    /// Lights given ready-made (a light file, in the probe's frame): used instead of extracting.
-    pub given: Option<LightSet>,
-    /// Hard or soft shadows.
-    pub shadows: ShadowKind,
-    /// SH bands of the hybrid ambient.
-    pub ambient_bands: usize,
-    /// Occlusion rays per shading point of the hybrid ambient.
-    pub occlusion_rays: u32,
-    /// Seed of the extraction (clustering restarts).
-    pub seed: u64,
-}
-
-impl LightingPlan {
-    /// The plan of a scene file's `[render]` mode and `[lighting]` table.
-    pub fn from_scene(scene: &Scene) -> LightingPlan {
-        let l = &scene.lighting;
-        LightingPlan {
-            mode: scene.render.mode,
-            method: l.method.clone(),
-            lights: l.lights as usize,
-            given: None,
-            shadows: l.shadows,
-            ambient_bands: l.ambient_bands as usize,
-            occlusion_rays: l.ao_samples,
-            seed: scene.render.seed,
-        }
-    }
-
-    /// Builds the lighting; also returns the light set used (none for the reference). Extraction
-    /// runs on the scene's probe (radiance scale applied), in the probe frame.
-    pub fn build(&self, scene: &Scene) -> Result<(Lighting, Option<LightSet>), crate::RenderError> {
-        use ibl_extract::{ExtractOptions, ModelSpec, build_model};
-        use ibl_scene::RenderMode;
-        if self.mode == RenderMode::Reference {
-            return Ok((Lighting::reference(scene)?, None));
-        }
-        let set = match &self.given {
-            Some(set) => set.clone(),
-            None => {
-                let spec: ModelSpec = self.method.parse()?;
-                if !matches!(spec, ModelSpec::Lights(_)) {
-                    return Err(crate::RenderError::Parameter(format!(
-                        "lighting method '{}' is not a light-extraction method (give the method; \
-                         the hybrid mode adds the SH ambient itself)",
-                        self.method
-                    )));
-                }
-                let options = ExtractOptions { seed: self.seed };
-                let (model, _) = build_model(&scene.probe.radiance, spec, self.lights, &options)?;
-                model.lights().cloned().ok_or_else(|| {
-                    crate::RenderError::Parameter(format!("'{}' made no lights", self.method))
-                })?
-            }
-        };
-        let lighting = match self.mode {
-            RenderMode::Lights => Lighting::lights(scene, &set, self.shadows)?,
-            _ => {
-                let hybrid = Hybrid::from_probe(
-                    &scene.probe.radiance,
-                    set.clone(),
-                    self.ambient_bands,
-                    ibl_sh::Window::None,
-                )?;
-                Lighting::hybrid(
-                    scene,
-                    &hybrid,
-                    ibl_sh::Window::None,
-                    self.shadows,
-                    self.occlusion_rays,
-                )?
-            }
-        };
-        Ok((lighting, Some(set)))
     }
 }

@@ -18,10 +18,12 @@
 use std::f64::consts::PI;
 
 use glam::DVec3;
+use ibl_core::rgb::Rgb64;
 use ibl_core::{Image, Rgb};
-use ibl_extract::{Light, LightSet};
-use ibl_render::lighting::LightingPlan;
-use ibl_render::{Lighting, RenderOutput, RenderSettings, render};
+use ibl_extract::{Hybrid, median_cut};
+use ibl_light::{Extraction, Light, LightSet, Provenance};
+use ibl_metrics::ImageDifference;
+use ibl_render::{Lighting, RenderError, RenderOutput, RenderSettings, render};
 use ibl_scene::description::CompositeRule;
 use ibl_scene::{RenderMode, Scene, SceneDescription, ShadowKind};
 
@@ -71,17 +73,40 @@ fn run(scene: &Scene, lighting: &Lighting, settings: &RenderSettings) -> RenderO
     render(scene, lighting, settings, &|_, _| {}).unwrap()
 }
 
-/// A plan for `mode` extracting `n` median-cut lights (hybrid: 3 SH bands, 4 occlusion rays).
-fn plan(mode: RenderMode, n: usize, shadows: ShadowKind) -> LightingPlan {
-    LightingPlan {
-        mode,
-        method: "median-cut".into(),
-        lights: n,
-        given: None,
-        shadows,
-        ambient_bands: 3,
-        occlusion_rays: 4,
-        seed: 1,
+/// The lighting of `mode` from `n` median-cut lights (`n` a power of two; hybrid: 3 SH bands,
+/// 4 occlusion rays), extracted from the scene's probe in its frame.
+struct Plan {
+    mode: RenderMode,
+    n: usize,
+    shadows: ShadowKind,
+}
+
+fn plan(mode: RenderMode, n: usize, shadows: ShadowKind) -> Plan {
+    Plan { mode, n, shadows }
+}
+
+impl Plan {
+    /// The lighting and, for the lights and hybrid modes, the lights used.
+    fn build(&self, scene: &Scene) -> Result<(Lighting, Option<LightSet>), RenderError> {
+        let probe = &scene.probe.radiance;
+        if self.mode == RenderMode::Reference {
+            return Ok((Lighting::reference(scene)?, None));
+        }
+        let set = median_cut(probe, self.n.trailing_zeros()).unwrap();
+        let lighting = if self.mode == RenderMode::Lights {
+            Lighting::lights(scene, &set, self.shadows)?
+        } else {
+            let hybrid = Hybrid::from_probe(probe, set.clone(), 3, ibl_sh::Window::None).unwrap();
+            Lighting::hybrid(
+                scene,
+                &hybrid.lights,
+                &hybrid.ambient,
+                ibl_sh::Window::None,
+                self.shadows,
+                4,
+            )?
+        };
+        Ok((lighting, Some(set)))
     }
 }
 
@@ -90,16 +115,18 @@ fn plan(mode: RenderMode, n: usize, shadows: ShadowKind) -> LightingPlan {
 fn one_light(direction: DVec3, irradiance: [f64; 3], solid_angle_sr: f64) -> LightSet {
     let d = direction.normalize();
     LightSet {
-        method: "test".into(),
+        provenance: Provenance::extracted(Extraction::Unknown {
+            name: "test".into(),
+        }),
         lights: vec![Light {
-            direction: d.to_array(),
+            direction: d,
             radiance: Rgb::new(
                 (irradiance[0] / solid_angle_sr) as f32,
                 (irradiance[1] / solid_angle_sr) as f32,
                 (irradiance[2] / solid_angle_sr) as f32,
             ),
             solid_angle_sr,
-            irradiance,
+            irradiance: Rgb64::from_array(irradiance),
             region: None,
         }],
     }
@@ -845,16 +872,8 @@ fn more_median_cut_lights_converge_to_the_reference() {
         &Lighting::reference(&scene).unwrap(),
         &settings(256, 1, 1, CompositeRule::Difference),
     );
-    let relative_mse = |a: &Image<Rgb>, b: &Image<Rgb>| {
-        let mut sum = 0.0f64;
-        for (p, q) in a.pixels().iter().zip(b.pixels()) {
-            for k in 0..3 {
-                let (x, y) = (f64::from(p[k]), f64::from(q[k]));
-                sum += (x - y) * (x - y) / (y * y + 0.01);
-            }
-        }
-        sum / (3 * a.len()) as f64
-    };
+    let relative_mse =
+        |a: &Image<Rgb>, b: &Image<Rgb>| ImageDifference::between(a, b, None).unwrap().relative_mse;
     let mut errors = Vec::new();
     for n in [1, 4, 16, 64] {
         let (lighting, set) = plan(RenderMode::Lights, n, ShadowKind::Hard)

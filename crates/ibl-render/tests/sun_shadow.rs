@@ -40,10 +40,11 @@
 
 use glam::DVec3;
 use ibl_core::{Image, LatLong, Rgb};
-use ibl_render::lighting::LightingPlan;
+use ibl_extract::{ExtractOptions, ModelSpec, build_model};
+use ibl_light::LightSet;
 use ibl_render::{Lighting, RenderOutput, RenderSettings, render};
 use ibl_scene::description::CompositeRule;
-use ibl_scene::{RenderMode, Scene, SceneDescription, ShadowKind};
+use ibl_scene::{Scene, SceneDescription, ShadowKind};
 
 /// Probe size (CONVENTIONS section 2: W = 2H).
 const PROBE_W: usize = 128;
@@ -216,17 +217,17 @@ fn settings(spp: u32, seed: u64) -> RenderSettings {
     }
 }
 
-fn plan(method: &str, lights: usize) -> LightingPlan {
-    LightingPlan {
-        mode: RenderMode::Lights,
-        method: method.into(),
-        lights,
-        given: None,
-        shadows: ShadowKind::Hard,
-        ambient_bands: 3,
-        occlusion_rays: 4,
-        seed: 1,
-    }
+/// The `lights` mode with hard shadows from `n` lights of `method` (a light method or `sun`),
+/// extracted from the scene's probe with seed 1.
+fn lights_mode(scene: &Scene, method: &str, n: usize) -> (Lighting, LightSet) {
+    let spec: ModelSpec = method.parse().unwrap();
+    let options = ExtractOptions { seed: 1 };
+    let (model, _) = build_model(&scene.probe.radiance, spec, n, &options).unwrap();
+    let set = model.lights().cloned().unwrap();
+    (
+        Lighting::lights(scene, &set, ShadowKind::Hard).unwrap(),
+        set,
+    )
 }
 
 #[test]
@@ -268,8 +269,8 @@ fn hard_sun_shadow_lands_where_the_reference_puts_it() {
     // (b)-(d) The light sets, 16 samples per pixel (hard shadows: a pixel's ratio is the share
     // of its jittered samples that see the lights).
     for (method, n) in [("sun", 1), ("median-cut", 16), ("lightgen", 16)] {
-        let (lighting, set) = plan(method, n).build(&scene).unwrap();
-        let lights = set.unwrap().lights.len();
+        let (lighting, set) = lights_mode(&scene, method, n);
+        let lights = set.lights.len();
         let out = run(&lighting, 16, 2);
         let shadow = measured_shadow(&out);
         let offset = shadow.offset(&reference_shadow);

@@ -2,11 +2,13 @@
 //! the world frame of `docs/CONVENTIONS.md` (+Y up, -Z forward, +X right).
 //!
 //! - [`description`]: the scene file format (TOML, versioned), validated field by field.
-//! - [`scene`]: a scene ready to render: real and virtual layers, probe, background, camera.
+//! - [`scene`]: a scene ready to render: real and virtual layers (geometry, BVH, shading and patch
+//!   attributes), probe, background, camera.
 //! - [`camera`]: panorama (the probe seen from its centre) and pinhole cameras.
 //! - [`primitives`]: planes, boxes and spheres as meshes.
 //! - [`mesh`]: indexed triangle meshes with material groups, validation and placement.
 //! - [`material`]: diffuse, glossy (Lambert + normalised Phong) and mirror surfaces.
+//! - [`patch`]: per-triangle radiosity attributes (reflectance, outgoing radiance).
 //! - [`ray`]: rays and hits.
 //! - [`bvh`]: a binned-SAH bounding volume hierarchy over triangles (closest hit, any hit).
 //!
@@ -17,6 +19,7 @@ pub mod camera;
 pub mod description;
 pub mod material;
 pub mod mesh;
+pub mod patch;
 pub mod primitives;
 pub mod ray;
 pub mod scene;
@@ -26,7 +29,9 @@ pub use camera::Camera;
 pub use description::{DescriptionError, FORMAT_VERSION, RenderMode, SceneDescription, ShadowKind};
 pub use material::Material;
 pub use mesh::{MeshError, TriangleMesh};
+pub use patch::PatchAttributes;
 pub use ray::{Hit, Ray};
 pub use scene::{
-    Background, GeometryLayer, MeshAsset, PlacedMesh, Probe, Scene, SurfacePoint, SurfaceTriangle,
+    Background, GeometryLayer, LayerError, MeshAsset, PlacedMesh, Probe, Scene, SurfacePoint,
+    SurfaceTriangle,
 };

@@ -58,6 +58,13 @@ pub enum MeshError {
     },
 }
 
+impl MeshError {
+    /// Always true: the mesh comes from a file or a caller.
+    pub fn is_bad_input(&self) -> bool {
+        true
+    }
+}
+
 impl TriangleMesh {
     /// Number of triangles.
     pub fn triangle_count(&self) -> usize {

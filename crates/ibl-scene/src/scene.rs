@@ -13,6 +13,7 @@ use crate::description::{
     BackgroundKind, DescriptionError, GeometryDescription, LightingDescription, RenderDescription,
     SceneDescription, ShapeKind,
 };
+use crate::patch::PatchAttributes;
 use crate::{Bvh, Camera, Hit, Material, TriangleMesh, primitives};
 
 /// Icosphere subdivisions of a `sphere` shape (20480 triangles).
@@ -44,17 +45,62 @@ pub struct SurfacePoint {
     pub material: Material,
 }
 
-/// Triangles with a BVH and what each looks like.
+/// Triangles with a BVH and what each looks like. The geometry (`triangles`) is kept beside the
+/// accelerator built over it, so that it can be subdivided into patches
+/// ([`GeometryLayer::from_parts`] rebuilds the BVH); `triangles`, `surfaces` and `patches` are
+/// parallel (one entry per triangle, the BVH's triangle indices).
 #[derive(Clone, Debug)]
 pub struct GeometryLayer {
-    /// Accelerator over the triangles (indices as in `surfaces`).
+    /// Corners of every triangle, world frame.
+    pub triangles: Vec<[Vec3; 3]>,
+    /// Accelerator over `triangles`.
     pub bvh: Bvh,
     /// Per-triangle shading data.
     pub surfaces: Vec<SurfaceTriangle>,
-    /// Materials referred to by `surfaces`.
+    /// Per-triangle radiosity data (reflectance, outgoing radiance).
+    pub patches: Vec<PatchAttributes>,
+    /// Materials referred to by `surfaces`: one per material group.
     pub materials: Vec<Material>,
+    /// Name of each material group (`object/group`), parallel to `materials`.
+    pub group_names: Vec<String>,
     /// Names of the objects, referred to by `surfaces`.
     pub object_names: Vec<String>,
+}
+
+/// Parts of a layer that do not fit together.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum LayerError {
+    /// The per-triangle lists differ in length.
+    #[error("{triangles} triangles but {surfaces} surfaces and {patches} patches")]
+    Lengths {
+        /// Triangles.
+        triangles: usize,
+        /// Shading entries.
+        surfaces: usize,
+        /// Radiosity entries.
+        patches: usize,
+    },
+    /// A surface refers to a material or object that is not there.
+    #[error("triangle {triangle} refers to a missing material or object")]
+    Index {
+        /// The triangle.
+        triangle: usize,
+    },
+    /// The group names do not match the materials.
+    #[error("{names} group names for {materials} materials")]
+    Groups {
+        /// Names.
+        names: usize,
+        /// Materials.
+        materials: usize,
+    },
+}
+
+impl LayerError {
+    /// Always true: the parts come from the caller.
+    pub fn is_bad_input(&self) -> bool {
+        true
+    }
 }
 
 /// A mesh with one material per material slot, to be placed in a layer.
@@ -69,17 +115,25 @@ pub struct PlacedMesh {
 }
 
 impl GeometryLayer {
-    /// A layer holding `meshes`. Cost: O(T log T) for T triangles (the BVH build).
+    /// A layer holding `meshes`; every triangle is one patch of its material's diffuse albedo.
+    /// Cost: O(T log T) for T triangles (the BVH build).
     pub fn new(meshes: Vec<PlacedMesh>) -> GeometryLayer {
         let mut corners = Vec::new();
         let mut surfaces = Vec::new();
+        let mut patches = Vec::new();
         let mut materials = Vec::new();
+        let mut group_names = Vec::new();
         let mut object_names = Vec::new();
         for (object, placed) in meshes.into_iter().enumerate() {
             let first_material = materials.len() as u32;
             materials.extend(placed.materials);
-            object_names.push(placed.name);
             let mesh = placed.mesh;
+            group_names.extend(
+                mesh.material_names
+                    .iter()
+                    .map(|group| format!("{}/{group}", placed.name)),
+            );
+            object_names.push(placed.name);
             for (i, tri) in mesh.triangles.iter().enumerate() {
                 let c = mesh.corners(i);
                 let geometric_normal = (c[1] - c[0]).cross(c[2] - c[0]).normalize_or_zero();
@@ -89,20 +143,66 @@ impl GeometryLayer {
                     tri.map(|v| mesh.normals[v as usize])
                 };
                 corners.push(c);
+                let material = first_material + mesh.material_slots[i];
                 surfaces.push(SurfaceTriangle {
                     normals,
                     geometric_normal,
-                    material: first_material + mesh.material_slots[i],
+                    material,
                     object: object as u32,
                 });
+                patches.push(PatchAttributes::unlit(
+                    materials[material as usize].diffuse_albedo(),
+                ));
             }
         }
         GeometryLayer {
             bvh: Bvh::new(&corners),
+            triangles: corners,
             surfaces,
+            patches,
             materials,
+            group_names,
             object_names,
         }
+    }
+
+    /// A layer from its parts (for instance after subdividing `triangles` into patches), the BVH
+    /// built anew. Cost: O(T log T).
+    pub fn from_parts(
+        triangles: Vec<[Vec3; 3]>,
+        surfaces: Vec<SurfaceTriangle>,
+        patches: Vec<PatchAttributes>,
+        materials: Vec<Material>,
+        group_names: Vec<String>,
+        object_names: Vec<String>,
+    ) -> Result<GeometryLayer, LayerError> {
+        if surfaces.len() != triangles.len() || patches.len() != triangles.len() {
+            return Err(LayerError::Lengths {
+                triangles: triangles.len(),
+                surfaces: surfaces.len(),
+                patches: patches.len(),
+            });
+        }
+        if group_names.len() != materials.len() {
+            return Err(LayerError::Groups {
+                names: group_names.len(),
+                materials: materials.len(),
+            });
+        }
+        if let Some(triangle) = surfaces.iter().position(|s| {
+            s.material as usize >= materials.len() || s.object as usize >= object_names.len()
+        }) {
+            return Err(LayerError::Index { triangle });
+        }
+        Ok(GeometryLayer {
+            bvh: Bvh::new(&triangles),
+            triangles,
+            surfaces,
+            patches,
+            materials,
+            group_names,
+            object_names,
+        })
     }
 
     /// An empty layer.

@@ -97,12 +97,17 @@ fn random_soup_matches_brute_force() {
                 assert_eq!((f.u, f.v), (b.u, b.v), "ray {r}: barycentrics");
                 let tri = tris[i];
                 let exact = plane_t(tri, &ray);
+                // The f32 Moller-Trumbore t against the plane intersection in f64: f32 rounding of
+                // a few products and one division, a few ulps (1e-6 relative); 1e-5, floored for t
+                // near 0.
                 assert!(
                     (f64::from(f.t) - exact).abs() <= 1e-5 * exact.abs().max(1e-3),
                     "ray {r}: t {} against f64 {exact}",
                     f.t
                 );
                 let p = tri[0] + f.u * (tri[1] - tri[0]) + f.v * (tri[2] - tri[0]);
+                // The hit point from barycentrics against the ray's point at t: f32 rounding of
+                // coordinates of order 10, 1e-5; 1e-4.
                 assert!((p - ray.at(f.t)).length() < 1e-4, "ray {r}: barycentrics");
                 assert!(f.u >= 0.0 && f.v >= 0.0 && f.u + f.v <= 1.0 + 1e-6);
             }
@@ -160,6 +165,8 @@ fn back_faces_are_hit() {
     for (z, d) in [(3.0, Vec3::NEG_Z), (-3.0, Vec3::Z)] {
         let ray = Ray::new(Vec3::new(0.5, 0.25, z), d);
         let hit = bvh.closest_hit(&ray, 0.0, f32::INFINITY).unwrap();
+        // t = 3 exactly in f32 for an axis-aligned ray and plane; 1e-6 allows one rounding of the
+        // division.
         assert!((hit.t - 3.0).abs() < 1e-6);
         // Point (0.5, 0.25) = 0.25 * corner 1 + 0.125 * corner 2.
         assert!(
@@ -233,6 +240,8 @@ fn rays_leaving_a_surface_skip_it_with_t_min() {
         if (p + d * expected_t).abs().max_element() < 5.0 {
             let h = hit.expect("the upper floor is hit");
             assert!(h.triangle >= 2, "never the start surface: {h:?}");
+            // Unit floor spacing: t = 1 / d.y, f32 rounding of the intersection (1e-7 relative);
+            // 1e-5.
             assert!((h.t - expected_t).abs() <= 1e-5 * expected_t);
         } else {
             assert_eq!(hit, None, "past the upper floor's edge the ray escapes");
@@ -279,6 +288,7 @@ fn single_triangle() {
     let hit = bvh.closest_hit(&ray, 0.0, f32::INFINITY).unwrap();
     assert_eq!(hit.triangle, 0);
     assert!((hit.t - 2.5).abs() < 1e-6);
+    // Barycentrics 0.25 and 0.5 of a plane through exact corners: f32 rounding (6e-8); 1e-6.
     assert!(
         (hit.u - 0.25).abs() < 1e-6 && (hit.v - 0.5).abs() < 1e-6,
         "{hit:?}"
@@ -405,6 +415,8 @@ fn closed_cube_is_watertight_from_inside() {
             let hit = bvh.closest_hit(&ray, 0.0, f32::INFINITY);
             let hit = hit.unwrap_or_else(|| panic!("escaped: {ray:?}"));
             let p = cube_from_world.transform_point3(ray.at(hit.t));
+            // Hits of a transformed unit cube lie on its faces: in the cube frame |p|_max = 1 to
+            // f32 rounding of the transform and t (1e-6); 1e-5.
             assert!(
                 (p.abs().max_element() - 1.0).abs() < 1e-5,
                 "{ray:?} hit {p} (cube frame)"
@@ -440,6 +452,8 @@ fn closed_cube_is_watertight_from_inside() {
         for &c in &corners {
             let ray = Ray::new(centre, (c - centre).normalize());
             let hit = bvh.closest_hit(&ray, 0.0, f32::INFINITY).unwrap();
+            // From the centre to a corner: sqrt 3 in f32, one rounding of the transform and t (1e-7
+            // relative); 1e-5.
             assert!((hit.t - 3.0f32.sqrt()).abs() < 1e-5, "{hit:?}");
         }
     }

@@ -110,7 +110,7 @@ fn defaults_fill_what_is_left_out() {
     assert_eq!(d.render.width, None);
     assert_eq!(d.render.composite, CompositeRule::Difference);
     let l = &d.lighting;
-    assert_eq!((l.method.as_str(), l.lights), ("median-cut", 16));
+    assert_eq!((l.method.name(), l.lights), ("median-cut", 16));
     assert_eq!((l.ambient_bands, l.ao_samples), (3, 16));
     assert!(l.lights_file.is_none());
 }
@@ -123,6 +123,7 @@ fn transform_is_scale_then_yaw_pitch_roll_then_translate() {
         SceneDescription::from_toml(&text.replace("translate = [1.0, 0.0, -2.0]\n", "")).unwrap();
     let m = d.object[1].world_from_model();
     let p = m.transform_point3(Vec3::new(0.0, 0.0, -1.0));
+    // Scale 2 then yaw 90 degrees in f32: sin/cos of pi/2 round to 1e-8, times 2; 1e-5.
     assert!(p.distance(Vec3::new(-2.0, 0.0, 0.0)) < 1e-5, "{p}");
 
     let text = format!("{BASE}scale = [1.0, 3.0, 1.0]\nrotate_deg = [0.0, 90.0, 0.0]\n");
@@ -139,6 +140,8 @@ fn transform_is_scale_then_yaw_pitch_roll_then_translate() {
     let d =
         SceneDescription::from_toml(&text.replace("translate = [1.0, 0.0, -2.0]\n", "")).unwrap();
     let p = d.object[1].world_from_model().transform_vector3(Vec3::X);
+    // Pitch then roll in f32 (quaternions of degrees): a few f32 roundings of unit vectors (1e-7);
+    // 1e-5.
     assert!(p.distance(Vec3::X) < 1e-5, "{p}");
 }
 

@@ -26,3 +26,11 @@ pub enum ShError {
     #[error("{0}")]
     Invalid(String),
 }
+
+impl ShError {
+    /// Always true: a band count out of range or unusable coefficients or probe are the
+    /// caller's input.
+    pub fn is_bad_input(&self) -> bool {
+        true
+    }
+}

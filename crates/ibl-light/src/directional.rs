@@ -1,0 +1,200 @@
+//! Directional light sets (CONVENTIONS sections 4 and 7; Madsen & Laursen 2006 section 3).
+//!
+//! A light `i` has a unit direction `w_i` (towards the light, world frame), a radiance `L_i` (linear
+//! RGB), a solid angle `A_i` (sr) and `I_i = L_i A_i`, the irradiance it gives a surface facing it.
+//! The irradiance of a set at normal `n` is `E(n) = sum_i I_i max(0, n . w_i)`. Irradiance is kept
+//! in f64 so that region methods conserve the probe's power to rounding (`sum_i I_i` equals
+//! `sum_p L_p dOmega_p`).
+//!
+//! The serde form of [`Light`] and [`PixelRegion`] is the per-light record of the light-set file
+//! (`direction`, `radiance`, `solid_angle`, `irradiance`, `region`; triples as JSON arrays), so
+//! `ibl-io` reads and writes these types as they are.
+
+use glam::{DMat3, DVec3};
+use ibl_core::Rgb;
+use ibl_core::rgb::Rgb64;
+use serde::{Deserialize, Serialize};
+
+use crate::Provenance;
+use crate::encoding;
+
+/// An axis-aligned block of lat-long pixels: columns `x0..x1`, rows `y0..y1` (half-open).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct PixelRegion {
+    /// First column.
+    pub x0: usize,
+    /// First row (row 0 at the top).
+    pub y0: usize,
+    /// One past the last column.
+    pub x1: usize,
+    /// One past the last row.
+    pub y1: usize,
+}
+
+impl PixelRegion {
+    /// Width in pixels.
+    pub fn width(&self) -> usize {
+        self.x1 - self.x0
+    }
+
+    /// Height in pixels.
+    pub fn height(&self) -> usize {
+        self.y1 - self.y0
+    }
+}
+
+/// One directional light.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Light {
+    /// Unit direction towards the light, world frame (+Y up, -Z forward).
+    #[serde(with = "encoding::dvec3")]
+    pub direction: DVec3,
+    /// Radiance `L = I / A`, linear RGB (the probe's unit, W sr^-1 m^-2 when calibrated).
+    #[serde(with = "encoding::rgb")]
+    pub radiance: Rgb,
+    /// Solid angle `A` of the source, sr.
+    #[serde(rename = "solid_angle")]
+    pub solid_angle_sr: f64,
+    /// `I = L A` per channel: the irradiance on a surface facing the light (probe unit x sr,
+    /// W m^-2 when calibrated).
+    #[serde(with = "encoding::rgb64")]
+    pub irradiance: Rgb64,
+    /// The probe pixels this light stands for (region methods only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub region: Option<PixelRegion>,
+}
+
+/// A set of directional lights approximating a probe, with what made it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LightSet {
+    /// The method (with its parameters) and the source probe.
+    pub provenance: Provenance,
+    /// The lights.
+    pub lights: Vec<Light>,
+}
+
+impl LightSet {
+    /// Irradiance at unit normal `n`, per channel: `sum_i I_i max(0, n . w_i)`. Cost O(N).
+    pub fn irradiance_at(&self, n: DVec3) -> [f64; 3] {
+        let mut e = [0.0; 3];
+        for l in &self.lights {
+            let c = n.dot(l.direction).max(0.0);
+            for (ec, ic) in e.iter_mut().zip(l.irradiance.to_array()) {
+                *ec += ic * c;
+            }
+        }
+        e
+    }
+
+    /// Total power of the set per channel, `sum_i I_i` (equals the probe's `sum L dOmega` for
+    /// region methods).
+    pub fn total_power(&self) -> [f64; 3] {
+        let mut p = [0.0; 3];
+        for l in &self.lights {
+            for (pc, ic) in p.iter_mut().zip(l.irradiance.to_array()) {
+                *pc += ic;
+            }
+        }
+        p
+    }
+
+    /// The same set with every direction turned by `b_from_a` (an orthogonal matrix taking this
+    /// set's frame `a` to frame `b`); regions and provenance are kept. Directions are not
+    /// renormalised, so a rotation there and back returns them to rounding.
+    pub fn transformed(&self, b_from_a: DMat3) -> LightSet {
+        LightSet {
+            provenance: self.provenance.clone(),
+            lights: self
+                .lights
+                .iter()
+                .map(|l| Light {
+                    direction: b_from_a * l.direction,
+                    ..*l
+                })
+                .collect(),
+        }
+    }
+
+    /// The same set with every radiance and irradiance multiplied by `scale` (an exposure
+    /// calibration, e.g. a scene's `radiance_scale`).
+    pub fn scaled(&self, scale: f64) -> LightSet {
+        LightSet {
+            provenance: self.provenance.clone(),
+            lights: self
+                .lights
+                .iter()
+                .map(|l| Light {
+                    irradiance: l.irradiance.map(|c| c * scale),
+                    radiance: l.radiance * scale as f32,
+                    ..*l
+                })
+                .collect(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{Extraction, Provenance};
+
+    fn set() -> LightSet {
+        LightSet {
+            provenance: Provenance::extracted(Extraction::AdaptiveMedianCut),
+            lights: vec![
+                Light {
+                    direction: DVec3::Y,
+                    radiance: Rgb::new(1.0, 2.0, 3.0),
+                    solid_angle_sr: 0.5,
+                    irradiance: Rgb64::new(0.5, 1.0, 1.5),
+                    region: None,
+                },
+                Light {
+                    direction: DVec3::NEG_Z,
+                    radiance: Rgb::splat(4.0),
+                    solid_angle_sr: 0.25,
+                    irradiance: Rgb64::new(1.0, 1.0, 1.0),
+                    region: Some(PixelRegion {
+                        x0: 1,
+                        y0: 2,
+                        x1: 4,
+                        y1: 8,
+                    }),
+                },
+            ],
+        }
+    }
+
+    #[test]
+    fn irradiance_is_the_clamped_cosine_sum() {
+        let s = set();
+        // Facing +Y: the first light fully, the second at 90 degrees (cos 0). Exact in binary.
+        assert_eq!(s.irradiance_at(DVec3::Y), [0.5, 1.0, 1.5]);
+        assert_eq!(s.irradiance_at(DVec3::NEG_Y), [0.0; 3]);
+        assert_eq!(s.total_power(), [1.5, 2.0, 2.5]);
+    }
+
+    #[test]
+    fn transforms_and_scales_keep_what_they_should() {
+        let s = set();
+        let turned = s.transformed(DMat3::from_rotation_y(std::f64::consts::FRAC_PI_2));
+        // A quarter turn about +Y takes -Z to -X; f64 rounding of sin/cos: below 1e-15.
+        assert!((turned.lights[1].direction - DVec3::NEG_X).length() < 1e-15);
+        assert_eq!(turned.lights[1].region, s.lights[1].region);
+        let scaled = s.scaled(2.0);
+        assert_eq!(scaled.lights[0].irradiance, Rgb64::new(1.0, 2.0, 3.0));
+        assert_eq!(scaled.lights[0].radiance, Rgb::new(2.0, 4.0, 6.0));
+        assert_eq!(scaled.provenance, s.provenance);
+    }
+
+    #[test]
+    fn regions_have_their_size() {
+        let r = PixelRegion {
+            x0: 1,
+            y0: 2,
+            x1: 4,
+            y1: 8,
+        };
+        assert_eq!((r.width(), r.height()), (3, 6));
+    }
+}

@@ -1,0 +1,34 @@
+//! Light types as data, low in the crate graph so that every producer (`ibl-extract`, and later
+//! `ibl-room` and `ibl-outdoor`), the file formats (`ibl-io`) and every consumer (`ibl-render`,
+//! the viewer, the Python bindings) share one definition:
+//!
+//! - [`directional`]: directional light sets (Madsen & Laursen 2006): per light a direction, a
+//!   radiance, a solid angle and `I = L A`, with the [`Provenance`] of the set;
+//! - [`method`]: the extraction methods by name ([`Method`], [`LightSource`]), what a scene file or
+//!   a command line asks for;
+//! - [`provenance`]: what made a set: the method with its parameters ([`Extraction`]) and the
+//!   source probe ([`ProbeRef`]);
+//! - [`patch`]: area patches of a room (Grosch 2005): position, normal, area, radiance;
+//! - [`goniometric`]: point lights with a candela table and an orientation (IES / EULUMDAT);
+//! - [`daylight`]: the sun (direction, irradiance) and the sky (Jensen, Andersen & Madsen 2006).
+//!
+//! Every colour is a linear Rec. 709 triple ([`ibl_core::Rgb`], or [`ibl_core::rgb::Rgb64`] where
+//! sums must conserve power) named for the quantity it holds, with its unit in the field's doc.
+//! Directions are unit vectors in the world frame (CONVENTIONS section 1) unless a field says
+//! otherwise. No algorithms and no I/O here: the serde form of [`LightSet`]'s lights is the
+//! interchange schema of CONVENTIONS section 7, written and read by `ibl-io`.
+
+pub mod daylight;
+pub mod directional;
+mod encoding;
+pub mod goniometric;
+pub mod method;
+pub mod patch;
+pub mod provenance;
+
+pub use daylight::{Sky, Sun};
+pub use directional::{Light, LightSet, PixelRegion};
+pub use goniometric::{CandelaTable, GoniometricLight, PhotometryError};
+pub use method::{LightSource, MAX_MEDIAN_CUT_SPLITS, Method, MethodError};
+pub use patch::AreaPatch;
+pub use provenance::{Extraction, FitReport, ParameterError, ProbeRef, Provenance};

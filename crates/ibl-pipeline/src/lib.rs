@@ -1,0 +1,49 @@
+//! Every multi-step job the front ends run, so that the `ibl` command line tool, the viewer and
+//! the Python bindings call the same code: each job takes an options struct, reads its inputs
+//! through `ibl-io`, runs the algorithms of the other crates, writes its outputs (atomically,
+//! never over an input) and returns a summary the front end shows (text, JSON, a widget).
+//! Progress and notes go through the [`Progress`] the front end supplies; nothing here prints.
+//!
+//! - [`envmap_files`]: environment maps on disk, one file in any mapping or six cube faces;
+//! - [`info`]: probe statistics; [`convert`]: mappings, formats, rotations, frame presets;
+//!   [`preview`]: tone-mapped pictures; [`irradiance`]: irradiance on normals and as maps;
+//! - [`lights`]: light sets in every format, hybrid lighting, overlays; [`sh`]: spherical
+//!   harmonics in every tool's convention; [`prefilter`](mod@prefilter): engine-ready maps (GGX
+//!   specular chains, irradiance cube, SH, DFG table as KTX2/DDS);
+//! - [`lighting_plan`]: what lights a render (mode, method, light-file rules);
+//!   [`render`]: a scene rendered and composited;
+//! - [`eval`]: the comparison of the extraction methods as a report folder; [`compare`]: image
+//!   metrics between two files;
+//! - [`capture`]: brackets merged to HDR; [`capture_views`]: mirror balls and fisheye pairs;
+//! - [`demo`]: the main job on the bundled probes and scenes ([`demo_probe`], [`demo_render`],
+//!   [`demo_page`], [`demo_paths`]).
+//!
+//! Errors are [`PipelineError`]s, split by cause; [`PipelineError::is_bad_input`] tells the
+//! caller's fault from ours.
+
+pub mod capture;
+pub mod capture_views;
+pub mod compare;
+pub mod convert;
+pub mod demo;
+pub mod demo_page;
+pub mod demo_paths;
+pub mod demo_probe;
+pub mod demo_render;
+pub mod envmap_files;
+pub mod error;
+pub mod eval;
+pub mod info;
+pub mod irradiance;
+pub mod lighting_plan;
+pub mod lights;
+pub mod prefilter;
+pub mod preview;
+pub mod progress;
+pub mod render;
+pub mod sh;
+
+pub use envmap_files::EnvMapping;
+pub use error::{PipelineError, Result};
+pub use lighting_plan::LightingPlan;
+pub use progress::{Progress, Silent};
