@@ -30,6 +30,7 @@ Examples:
   ibl preview probe.exr probe.png --tonemap aces
   ibl lights probe.exr -n 16 -o lights.json
   ibl eval assets/probes/*.exr --out eval     compare every extraction method (report.md)
+  ibl prefilter probe.exr -o env.ktx2        GGX mip chain, irradiance, SH, DFG for engines
   ibl render assets/scenes/bunny-sky.toml -o bunny.exr   the bunny composited into a probe
   ibl compare render.exr reference.exr       RMSE, relative MSE and FLIP of a render
   ibl capture merge IMG_*.jpg -o probe.exr   bracketed exposures to HDR
@@ -49,6 +50,8 @@ enum Command {
     Lights(cmd::lights::LightsArgs),
     /// Spherical-harmonic lighting of a probe, in iblkit's JSON or another tool's convention.
     Sh(cmd::sh::ShArgs),
+    /// Engine-ready maps: GGX specular mip chain (KTX2/DDS), irradiance cube, SH, DFG table.
+    Prefilter(cmd::prefilter::PrefilterArgs),
     /// Compare the light extraction methods on probes: error vs N, plots, spheres, report.
     Eval(cmd::eval::EvalArgs),
     /// Error metrics of an image against a reference: RMSE, relative MSE, FLIP; error images.
@@ -84,6 +87,7 @@ fn main() -> ExitCode {
         Command::Irradiance(args) => cmd::irradiance::run(&args),
         Command::Lights(args) => cmd::lights::run(&args),
         Command::Sh(args) => cmd::sh::run(&args),
+        Command::Prefilter(args) => cmd::prefilter::run(&args),
         Command::Eval(args) => cmd::eval::run(&args),
         Command::Compare(args) => cmd::compare::run(&args),
         Command::Render(args) => cmd::render::run(&args),

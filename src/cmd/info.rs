@@ -16,9 +16,11 @@ Examples:
   ibl info assets/probes/esplanade.exr
   ibl info probe.hdr --json | jq .brightest
   ibl info ball.exr --mapping mirror-ball
+  ibl info env.ktx2                         # a KTX2/DDS cube: format, levels, faces
   ibl info probe.exr --frame blender        # brightest direction in Blender's Z-up axes")]
 pub struct InfoArgs {
-    /// The image to describe (.hdr, .exr, .pfm, .png, .jpg).
+    /// The image to describe (.hdr, .exr, .pfm, .png, .jpg; .ktx2 and .dds: level 0, a cube map
+    /// as its six faces side by side).
     pub file: PathBuf,
     /// Mapping of the image (default: guessed from its shape; 2:1 is lat-long, 1:1 angular).
     #[arg(long, value_name = "MAPPING")]

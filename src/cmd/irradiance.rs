@@ -91,8 +91,8 @@ pub fn run(args: &IrradianceArgs) -> anyhow::Result<()> {
         };
         let mean = summary.mean_irradiance;
         println!(
-            "{what} in {:.2} s; mean E = {:.5e} {:.5e} {:.5e}",
-            summary.seconds, mean[0], mean[1], mean[2]
+            "{what} in {:.2} s; mean E = {:.5e} {:.5e} {:.5e} (over {} normals)",
+            summary.seconds, mean[0], mean[1], mean[2], summary.mean_over_normals
         );
         if let (Some(m), Some(x)) = (summary.mean_err_pct, summary.max_err_pct) {
             println!(

@@ -23,7 +23,9 @@ pub use fibonacci::fibonacci_normals;
 pub use frame::{EulerDegrees, FramePreset};
 pub use glam;
 pub use image::Image;
-pub use irradiance::{RowIrradiance, channel_means, irradiance_exact, valid_radiance};
+pub use irradiance::{
+    RowIrradiance, channel_means, irradiance_exact, irradiance_exact_with_progress, valid_radiance,
+};
 pub use latlong::LatLong;
 pub use rgb::Rgb;
 pub use summed_area::SummedAreaTable;

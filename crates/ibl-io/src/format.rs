@@ -23,20 +23,26 @@ pub enum ImageFormat {
     Png,
     /// JPEG (`.jpg`, `.jpeg`), sRGB.
     Jpeg,
+    /// KTX 2.0 texture (`.ktx2`): level 0, a cube map as its six faces side by side.
+    Ktx2,
+    /// DirectDraw Surface texture (`.dds`): level 0, a cube map as its six faces side by side.
+    Dds,
 }
 
 impl ImageFormat {
     /// Every format, in a fixed order.
-    pub const ALL: [ImageFormat; 5] = [
+    pub const ALL: [ImageFormat; 7] = [
         ImageFormat::Hdr,
         ImageFormat::Exr,
         ImageFormat::Pfm,
         ImageFormat::Png,
         ImageFormat::Jpeg,
+        ImageFormat::Ktx2,
+        ImageFormat::Dds,
     ];
 
     /// The format named by the path's extension (case-insensitive): `.hdr`/`.pic`, `.exr`, `.pfm`,
-    /// `.png`, `.jpg`/`.jpeg`. `None` for any other or no extension.
+    /// `.png`, `.jpg`/`.jpeg`, `.ktx2`, `.dds`. `None` for any other or no extension.
     pub fn from_path(path: &Path) -> Option<ImageFormat> {
         let ext = path.extension()?.to_str()?.to_ascii_lowercase();
         match ext.as_str() {
@@ -45,11 +51,13 @@ impl ImageFormat {
             "pfm" => Some(ImageFormat::Pfm),
             "png" => Some(ImageFormat::Png),
             "jpg" | "jpeg" => Some(ImageFormat::Jpeg),
+            "ktx2" => Some(ImageFormat::Ktx2),
+            "dds" => Some(ImageFormat::Dds),
             _ => None,
         }
     }
 
-    /// Short lower-case name: `"hdr"`, `"exr"`, `"pfm"`, `"png"` or `"jpeg"`.
+    /// Short lower-case name: `"hdr"`, `"exr"`, `"pfm"`, `"png"`, `"jpeg"`, `"ktx2"` or `"dds"`.
     pub fn name(self) -> &'static str {
         match self {
             ImageFormat::Hdr => "hdr",
@@ -57,13 +65,21 @@ impl ImageFormat {
             ImageFormat::Pfm => "pfm",
             ImageFormat::Png => "png",
             ImageFormat::Jpeg => "jpeg",
+            ImageFormat::Ktx2 => "ktx2",
+            ImageFormat::Dds => "dds",
         }
     }
 
-    /// Whether the format stores linear high-dynamic-range values (`.hdr`, `.exr`, `.pfm`) rather
-    /// than 8/16-bit display-referred sRGB.
+    /// Whether the format stores linear high-dynamic-range values (`.hdr`, `.exr`, `.pfm`,
+    /// `.ktx2`, `.dds`) rather than 8/16-bit display-referred sRGB.
     pub fn is_hdr(self) -> bool {
-        matches!(self, ImageFormat::Hdr | ImageFormat::Exr | ImageFormat::Pfm)
+        !matches!(self, ImageFormat::Png | ImageFormat::Jpeg)
+    }
+
+    /// Whether the format is a GPU texture container (KTX2, DDS) that can hold a cube map and
+    /// mip levels.
+    pub fn is_texture(self) -> bool {
+        matches!(self, ImageFormat::Ktx2 | ImageFormat::Dds)
     }
 
     /// The format the first bytes of a file look like, if any (used for error hints).
@@ -81,6 +97,10 @@ impl ImageFormat {
             Some(ImageFormat::Png)
         } else if bytes.starts_with(&[0xff, 0xd8, 0xff]) {
             Some(ImageFormat::Jpeg)
+        } else if bytes.starts_with(&crate::ktx2::IDENTIFIER) {
+            Some(ImageFormat::Ktx2)
+        } else if bytes.starts_with(b"DDS ") {
+            Some(ImageFormat::Dds)
         } else {
             None
         }
@@ -183,13 +203,15 @@ mod tests {
             ("a.PNG", ImageFormat::Png),
             ("a.jpg", ImageFormat::Jpeg),
             ("a.JPEG", ImageFormat::Jpeg),
+            ("a.KTX2", ImageFormat::Ktx2),
+            ("a.dds", ImageFormat::Dds),
         ] {
             assert_eq!(ImageFormat::from_path(Path::new(name)), Some(f), "{name}");
         }
         assert_eq!(ImageFormat::from_path(Path::new("a.tiff")), None);
         assert_eq!(ImageFormat::from_path(Path::new("exr")), None);
         let names: Vec<_> = ImageFormat::ALL.iter().map(|f| f.name()).collect();
-        assert_eq!(names, ["hdr", "exr", "pfm", "png", "jpeg"]);
+        assert_eq!(names, ["hdr", "exr", "pfm", "png", "jpeg", "ktx2", "dds"]);
     }
 
     #[test]

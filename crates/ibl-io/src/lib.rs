@@ -17,10 +17,12 @@
 //! destination, so a reader never sees a half-written file and a failed write leaves any previous
 //! file untouched (`docs/CONVENTIONS.md`, section 7).
 
+pub mod dds;
 mod error;
 pub mod exr;
 mod format;
 pub mod hdr;
+pub mod ktx2;
 pub mod ldr;
 pub mod light_export;
 pub mod light_file;
@@ -31,6 +33,7 @@ pub mod sanitize;
 pub mod scene_file;
 pub mod scene_write;
 pub mod sh_file;
+pub mod texture;
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -46,6 +49,7 @@ pub use mesh_file::{LoadedMesh, MeshLimits, read_mesh};
 pub use sanitize::{SanitizeReport, sanitize};
 pub use scene_file::{LoadedScene, read_scene};
 pub use sh_file::{ShFile, ShFileFormat, ShQuantity, read_sh_file, write_sh_file};
+pub use texture::{DecodedTexture, TexelFormat, Texture, TextureKind, TextureLevel};
 
 /// An image read from a file, with what reading did to it.
 #[derive(Clone, Debug, PartialEq)]
@@ -67,12 +71,15 @@ pub struct WriteOptions {
     pub exr: ExrOptions,
     /// Exposure and tone curve of `.png`/`.jpg` output.
     pub display: Display,
+    /// Texel format of `.ktx2`/`.dds` output (half floats by default).
+    pub texture: TexelFormat,
 }
 
 fn format_of(path: &Path) -> Result<ImageFormat, IoError> {
     ImageFormat::from_path(path).ok_or_else(|| IoError::Unsupported {
         path: path.to_path_buf(),
-        what: "file extension (expected .hdr, .pic, .exr, .pfm, .png, .jpg or .jpeg)".into(),
+        what: "file extension (expected .hdr, .pic, .exr, .pfm, .png, .jpg, .jpeg, .ktx2 or .dds)"
+            .into(),
     })
 }
 
@@ -83,7 +90,115 @@ fn decode(format: ImageFormat, bytes: &[u8], limits: &Limits) -> Result<RawImage
         ImageFormat::Exr => exr::decode(bytes, limits),
         ImageFormat::Pfm => pfm::decode(bytes, limits),
         ImageFormat::Png | ImageFormat::Jpeg => ldr::decode(bytes, limits),
+        ImageFormat::Ktx2 => ktx2::decode(bytes, limits).map(texture_level0),
+        ImageFormat::Dds => dds::decode(bytes, limits).map(texture_level0),
     }
+}
+
+/// Level 0 of a texture as an RGB image: a 2D texture as it is (a two-channel table with blue
+/// 0), a cube map as its six faces side by side, `+X -X +Y -Y +Z -Z` (the cube-strip layout).
+fn texture_level0(decoded: DecodedTexture) -> RawImage {
+    let DecodedTexture {
+        texture, details, ..
+    } = decoded;
+    let channels = texture.channels;
+    let faces = texture.kind.faces();
+    let level = texture.levels.into_iter().next();
+    let (w, h, data) = match level {
+        Some(l) => (l.width, l.height, l.faces),
+        None => (0, 0, Vec::new()),
+    };
+    let image = Image::from_fn_par(w * faces, h, |x, y| {
+        let (face, i) = (x / w.max(1), x % w.max(1));
+        let t = &data[face][(y * w + i) * channels..];
+        Rgb::new(t[0], t[1], if channels > 2 { t[2] } else { 0.0 })
+    });
+    RawImage { image, details }
+}
+
+/// Reads a KTX2 or DDS texture with every level and face (the format from the extension).
+pub fn read_texture(path: &Path, limits: &Limits) -> Result<DecodedTexture, IoError> {
+    let format = format_of(path)?;
+    let bytes = std::fs::read(path).map_err(|e| IoError::read(path, e))?;
+    let decoded = match format {
+        ImageFormat::Ktx2 => ktx2::decode(&bytes, limits),
+        ImageFormat::Dds => dds::decode(&bytes, limits),
+        _ => {
+            return Err(IoError::Unsupported {
+                path: path.to_path_buf(),
+                what: format!(
+                    "{} is not a texture container (use .ktx2 or .dds)",
+                    format.name()
+                ),
+            });
+        }
+    };
+    decoded.map_err(|e| e.with_path(path))
+}
+
+/// Encodes a texture for `.ktx2` or `.dds` in `texel` format.
+pub fn encode_texture(
+    format: ImageFormat,
+    texture: &Texture,
+    texel: TexelFormat,
+) -> Result<Vec<u8>, EncodeError> {
+    match format {
+        ImageFormat::Ktx2 => ktx2::encode(texture, texel).map_err(EncodeError::new),
+        ImageFormat::Dds => dds::encode(texture, texel).map_err(EncodeError::new),
+        other => Err(EncodeError::new(format!(
+            "{} cannot hold a texture with mip levels (use .ktx2 or .dds)",
+            other.name()
+        ))),
+    }
+}
+
+/// Writes a texture (mip levels, cube faces) as `.ktx2` or `.dds` (by extension), atomically.
+pub fn write_texture(path: &Path, texture: &Texture, texel: TexelFormat) -> Result<(), IoError> {
+    let format = format_of(path)?;
+    if !format.is_texture() {
+        return Err(IoError::Unsupported {
+            path: path.to_path_buf(),
+            what: "a texture with mip levels needs a .ktx2 or .dds file".into(),
+        });
+    }
+    let bytes = encode_texture(format, texture, texel).map_err(|e| e.with_path(path))?;
+    write_atomically(path, &bytes)
+}
+
+/// A one-level texture of an RGB image (`Flat`), or of the six faces of a cube strip (`Cube`:
+/// the image must be `6 S x S`).
+pub fn texture_of_image(image: &Image<Rgb>, kind: TextureKind) -> Result<Texture, EncodeError> {
+    let faces = kind.faces();
+    let (w, h) = (image.width() / faces, image.height());
+    if w == 0 || h == 0 || w * faces != image.width() || (kind == TextureKind::Cube && w != h) {
+        return Err(EncodeError::new(format!(
+            "a {} x {} image is not a {}",
+            image.width(),
+            image.height(),
+            if kind == TextureKind::Cube {
+                "6:1 strip of square cube faces"
+            } else {
+                "texture"
+            }
+        )));
+    }
+    let faces = (0..faces)
+        .map(|f| {
+            (0..h)
+                .flat_map(|y| image.row(y)[f * w..(f + 1) * w].iter())
+                .flat_map(|p| [p.r, p.g, p.b])
+                .collect()
+        })
+        .collect();
+    Ok(Texture {
+        kind,
+        channels: 3,
+        levels: vec![TextureLevel {
+            width: w,
+            height: h,
+            faces,
+        }],
+    })
 }
 
 /// Reads every image in `dir` whose extension is `extension` (case-insensitive), in file-name
@@ -167,7 +282,8 @@ pub fn read_image_with_limits(path: &Path, limits: &Limits) -> Result<LoadedImag
 }
 
 /// Encodes an image for a format: `.hdr` RLE, `.exr` per `options.exr`, `.pfm` little-endian,
-/// `.png`/`.jpg` tone-mapped with `options.display` (JPEG quality 92).
+/// `.png`/`.jpg` tone-mapped with `options.display` (JPEG quality 92), `.ktx2`/`.dds` as one 2D
+/// level in `options.texture` (use [`write_texture`] for cube maps and mip chains).
 pub fn encode_image(
     format: ImageFormat,
     image: &Image<Rgb>,
@@ -183,6 +299,10 @@ pub fn encode_image(
         ImageFormat::Png => ldr::encode_png(&to_srgb8(image, &options.display)),
         ImageFormat::Jpeg => {
             ldr::encode_jpeg(&to_srgb8(image, &options.display), ldr::JPEG_QUALITY)
+        }
+        ImageFormat::Ktx2 | ImageFormat::Dds => {
+            let texture = texture_of_image(image, TextureKind::Flat)?;
+            encode_texture(format, &texture, options.texture)
         }
     }
 }

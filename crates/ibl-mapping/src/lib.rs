@@ -16,21 +16,38 @@
 //! * [`resample`](mod@resample): area-averaging resampling and rotation (rows in parallel,
 //!   deterministic).
 //! * [`power`](mod@power): `sum L dOmega` per channel.
+//! * [`prefilter`](mod@prefilter): engine-ready maps in one call: the GGX specular chain
+//!   ([`specular`] over a seamless [`cube_pyramid`] split by [`specular_source`], roughness per
+//!   level from [`ggx`]), the
+//!   irradiance cube, SH and the split-sum table ([`dfg`]).
 
 pub mod cube;
+pub mod cube_pyramid;
+pub mod dfg;
 pub mod disc;
 mod error;
 pub mod fisheye;
+pub mod ggx;
 pub mod mapping;
 pub mod power;
+pub mod prefilter;
 pub mod projection;
 pub mod resample;
+pub mod specular;
+pub mod specular_source;
 pub mod taps;
 
 pub use cube::{CUBE_FACE_NAMES, join_cube_faces, split_cube_faces};
+pub use cube_pyramid::CubePyramid;
+pub use dfg::{Dfg, DfgLayout};
 pub use error::MappingError;
+pub use ggx::EngineTarget;
 pub use mapping::{CubeLayout, MAPPING_NAMES, Mapping};
 pub use power::{power, try_power};
+pub use prefilter::{
+    DfgOptions, PrefilterOptions, Prefiltered, SpecularChain, SpecularOptions, prefilter,
+};
 pub use projection::Projection;
 pub use resample::{resample, rotate};
+pub use specular_source::SpecularSource;
 pub use taps::Taps;

@@ -280,7 +280,11 @@ fn write_error_image(
                 scale_top: Some(top),
             })
         }
-        ImageFormat::Exr | ImageFormat::Hdr | ImageFormat::Pfm => {
+        ImageFormat::Exr
+        | ImageFormat::Hdr
+        | ImageFormat::Pfm
+        | ImageFormat::Ktx2
+        | ImageFormat::Dds => {
             let grey = map.map(|&v| Rgb::splat(v));
             ibl_io::write_image(out, &grey, &WriteOptions::default())?;
             Ok(ErrorImage {

@@ -15,9 +15,11 @@ use crate::error::Result;
 /// brightest direction in `frame`'s axes. Cost O(W H).
 pub fn probe_info(path: &Path, mapping: Option<EnvMapping>, frame: FramePreset) -> Result<Info> {
     let env = envmap_files::load(path, mapping)?;
+    // A KTX2/DDS cube map says it is one: its mapping is read, not guessed.
+    let cube_texture = env.format.is_texture() && env.details.contains("cube");
     Ok(describe(
         &env,
-        mapping.is_none(),
+        mapping.is_none() && !cube_texture,
         frame,
         &path.display().to_string(),
     ))

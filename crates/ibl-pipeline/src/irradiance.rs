@@ -89,8 +89,11 @@ pub struct IrradianceSummary {
     pub window: Option<&'static str>,
     /// Seconds to compute and write.
     pub seconds: f64,
-    /// Mean irradiance over [`CHECK_NORMALS`] Fibonacci normals, per channel.
+    /// Mean irradiance over `mean_over_normals` Fibonacci normals, per channel.
     pub mean_irradiance: [f64; 3],
+    /// How many normals the mean is over: the CSV's own when its values serve (an exact CSV is
+    /// already the answer), else [`CHECK_NORMALS`].
+    pub mean_over_normals: usize,
     /// Error against the exact ground truth on [`CHECK_NORMALS`] Fibonacci normals (approximate
     /// methods), per cent of the mean irradiance.
     pub mean_err_pct: Option<f64>,
@@ -101,16 +104,17 @@ pub struct IrradianceSummary {
 }
 
 /// An irradiance evaluator for one probe and method.
-enum Evaluator {
-    Exact(ibl_core::RowIrradiance),
-    Fast(Image<Rgb>),
+enum Evaluator<'a> {
+    /// Rows streamed through the cache, all normals per row ([`ibl_core::irradiance_exact`]).
+    Exact(&'a Image<Rgb>),
+    Fast(&'a Image<Rgb>),
     Sh(ibl_sh::IrradianceSh),
 }
 
-impl Evaluator {
+impl Evaluator<'_> {
     fn irradiance(&self, dirs: &[DVec3]) -> Vec<[f64; 3]> {
         match self {
-            Evaluator::Exact(rows) => rows.irradiance(dirs),
+            Evaluator::Exact(probe) => ibl_core::irradiance_exact(probe, dirs),
             Evaluator::Fast(probe) => {
                 ibl_eval::irradiance_fast(probe, dirs, ibl_eval::FAST_DEFAULT_SIZE)
             }
@@ -171,8 +175,8 @@ pub fn irradiance(o: &IrradianceOptions, progress: &dyn Progress) -> Result<Irra
 fn compute(o: &IrradianceOptions, probe: &Image<Rgb>) -> Result<IrradianceSummary> {
     let start = Instant::now();
     let evaluator = match o.method {
-        IrradianceMethod::Exact => Evaluator::Exact(ibl_core::RowIrradiance::new(probe)),
-        IrradianceMethod::Fast => Evaluator::Fast(probe.clone()),
+        IrradianceMethod::Exact => Evaluator::Exact(probe),
+        IrradianceMethod::Fast => Evaluator::Fast(probe),
         IrradianceMethod::Sh => Evaluator::Sh(
             project_latlong(probe, o.bands)
                 .context(o.probe.display().to_string())?
@@ -180,6 +184,8 @@ fn compute(o: &IrradianceOptions, probe: &Image<Rgb>) -> Result<IrradianceSummar
         ),
     };
     let mut outputs = Vec::new();
+    // The CSV's values, kept when its normals are the summary's (no second evaluation).
+    let mut reusable: Option<Vec<[f64; 3]>> = None;
     if let Some(csv) = &o.csv {
         let normals = fibonacci_normals(o.normals);
         let e = evaluator.irradiance(&normals);
@@ -190,6 +196,9 @@ fn compute(o: &IrradianceOptions, probe: &Image<Rgb>) -> Result<IrradianceSummar
         }
         ibl_io::write_atomically(csv, text.as_bytes())?;
         outputs.push(csv.display().to_string());
+        if o.method == IrradianceMethod::Exact || o.normals == CHECK_NORMALS {
+            reusable = Some(e);
+        }
     }
     if let Some(out) = &o.output {
         let map = irradiance_map(&evaluator, o.to.in_memory(), o.width);
@@ -203,12 +212,17 @@ fn compute(o: &IrradianceOptions, probe: &Image<Rgb>) -> Result<IrradianceSummar
         outputs.extend(written.iter().map(|p| p.display().to_string()));
     }
     let seconds = start.elapsed().as_secs_f64();
-    // The mean irradiance, and for approximate methods the error against the exact ground truth.
-    let check_normals = fibonacci_normals(CHECK_NORMALS);
-    let check = evaluator.irradiance(&check_normals);
+    // The mean irradiance, and for approximate methods the error against the exact ground truth,
+    // on the CSV's own values when they serve: an exact CSV is already the answer (its mean is
+    // over its own normals), and an approximate one on the 20000 check normals is the check.
+    let check = match reusable {
+        Some(values) => values,
+        None => evaluator.irradiance(&fibonacci_normals(CHECK_NORMALS)),
+    };
+    let mean_over_normals = check.len();
     let mean = ibl_core::channel_means(&check);
     let errors = (o.method != IrradianceMethod::Exact).then(|| {
-        let truth = ibl_core::irradiance_exact(probe, &check_normals);
+        let truth = ibl_core::irradiance_exact(probe, &fibonacci_normals(CHECK_NORMALS));
         IrradianceError::between(&truth, &check)
     });
     let is_sh = o.method == IrradianceMethod::Sh;
@@ -219,6 +233,7 @@ fn compute(o: &IrradianceOptions, probe: &Image<Rgb>) -> Result<IrradianceSummar
         window: is_sh.then_some(o.window.name()),
         seconds,
         mean_irradiance: mean,
+        mean_over_normals,
         mean_err_pct: errors.as_ref().map(|e| e.mean_err_pct),
         max_err_pct: errors.as_ref().map(|e| e.max_err_pct),
         outputs,

@@ -8,7 +8,8 @@
 //! - [`info`]: probe statistics; [`convert`]: mappings, formats, rotations, frame presets;
 //!   [`preview`]: tone-mapped pictures; [`irradiance`]: irradiance on normals and as maps;
 //! - [`lights`]: light sets in every format, hybrid lighting, overlays; [`sh`]: spherical
-//!   harmonics in every tool's convention;
+//!   harmonics in every tool's convention; [`prefilter`](mod@prefilter): engine-ready maps (GGX
+//!   specular chains, irradiance cube, SH, DFG table as KTX2/DDS);
 //! - [`lighting_plan`]: what lights a render (mode, method, light-file rules);
 //!   [`render`]: a scene rendered and composited;
 //! - [`eval`]: the comparison of the extraction methods as a report folder; [`compare`]: image
@@ -36,6 +37,7 @@ pub mod info;
 pub mod irradiance;
 pub mod lighting_plan;
 pub mod lights;
+pub mod prefilter;
 pub mod preview;
 pub mod progress;
 pub mod render;
