@@ -10,4 +10,5 @@ pub mod irradiance;
 pub mod lights;
 pub mod preview;
 pub mod render;
+pub mod room;
 pub mod sh;
