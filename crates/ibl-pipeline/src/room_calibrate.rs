@@ -130,7 +130,11 @@ pub fn room_calibrate(o: &CalibrateOptions, progress: &dyn Progress) -> Result<C
         Some(probe_height(&marks, world_from_probe).context(name.clone())?)
     };
     let marks_folder = absolute_folder(&o.marks)?;
-    let probe_path = marks.probe.as_ref().map(|p| marks_folder.join(&p.file));
+    // Canonical where the probe exists, so the room file names it without `a/../` detours.
+    let probe_path = marks.probe.as_ref().map(|p| {
+        let joined = marks_folder.join(&p.file);
+        joined.canonicalize().unwrap_or(joined)
+    });
     let proposal = if o.propose {
         let probe_path = probe_path.as_ref().ok_or_else(|| {
             PipelineError::parameter(format!(
