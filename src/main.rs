@@ -60,6 +60,8 @@ enum Command {
     Capture(cmd::capture::CaptureArgs),
     /// Render virtual objects into the probe panorama or a photo (reference, lights, hybrid).
     Render(cmd::render::RenderArgs),
+    /// The reconstructed room (Grosch 2005): calibrate marks, estimate reflectance, light patches.
+    Room(cmd::room::RoomArgs),
     /// Write a tone-mapped 8-bit preview (PNG or JPEG) of an HDR image.
     Preview(cmd::preview::PreviewArgs),
     /// Run the main job on the bundled probes and write everything to a folder.
@@ -92,6 +94,7 @@ fn main() -> ExitCode {
         Command::Compare(args) => cmd::compare::run(&args),
         Command::Render(args) => cmd::render::run(&args),
         Command::Capture(args) => cmd::capture::run(&args),
+        Command::Room(args) => cmd::room::run(&args),
         Command::Preview(args) => cmd::preview::run(&args),
         Command::Demo(args) => cmd::demo::run(&args),
         Command::View(args) => cmd::view::run(&args),

@@ -385,6 +385,25 @@ fn demo_writes_every_mapping_and_an_index() {
             );
         }
     }
+
+    // The worked example's room: every file written, converged in at most 5 iterations (issue
+    // 16), every surface group with a reflectance in (0, 1), the important patches exported.
+    let room = &summary["room"];
+    for f in room["files"].as_array().unwrap() {
+        assert!(out_dir.join(f.as_str().unwrap()).exists(), "{f}");
+    }
+    assert!(room["converged"].as_bool().unwrap());
+    assert!(room["iterations"].as_u64().unwrap() <= 5);
+    for g in room["groups"].as_array().unwrap() {
+        if let Some(rho) = g["reflectance"].as_array() {
+            for c in rho {
+                let c = c.as_f64().unwrap();
+                assert!(c > 0.0 && c < 1.0, "{}: {c}", g["name"]);
+            }
+        }
+    }
+    let html = std::fs::read_to_string(out_dir.join("index.html")).unwrap();
+    assert!(html.contains("id=room") && html.contains("room/rho-panorama.png"));
 }
 
 #[test]

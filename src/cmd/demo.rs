@@ -29,6 +29,10 @@ pub struct DemoArgs {
     /// Folder of scene files to render (default: the bundled `assets/scenes`).
     #[arg(long, value_name = "DIR")]
     pub scenes: Option<PathBuf>,
+    /// Room file of the reconstructed-room section (default: the bundled
+    /// `assets/rooms/apartment/room.toml`).
+    #[arg(long, value_name = "ROOM.toml")]
+    pub room: Option<PathBuf>,
 }
 
 /// The bundled `assets` folder: beside the binary's source tree, else in the current folder.
@@ -53,6 +57,11 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
             .scenes
             .clone()
             .unwrap_or_else(|| assets_dir().join("scenes")),
+        room: Some(
+            args.room
+                .clone()
+                .unwrap_or_else(|| assets_dir().join("rooms/apartment/room.toml")),
+        ),
     };
     let made = demo(&options, &Bars::default())?;
     print_summary(&args.out, &made.probes);
@@ -66,6 +75,14 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
         "  {}/{RENDER_DIR}/report.md the example scenes rendered, lights scored against the reference",
         args.out.display()
     );
+    if let Some(room) = &made.room {
+        println!(
+            "  {}/room/report.md        the reconstructed room: {} patches, rho per group, {} important patches",
+            args.out.display(),
+            room.patches,
+            ibl_pipeline::demo_room::DEMO_IMPORTANT_PATCHES
+        );
+    }
     Ok(())
 }
 

@@ -11,5 +11,6 @@ pub mod lights;
 pub mod prefilter;
 pub mod preview;
 pub mod render;
+pub mod room;
 pub mod sh;
 pub mod view;

@@ -17,6 +17,7 @@
 //! destination, so a reader never sees a half-written file and a failed write leaves any previous
 //! file untouched (`docs/CONVENTIONS.md`, section 7).
 
+pub mod area_light_file;
 pub mod dds;
 mod error;
 pub mod exr;

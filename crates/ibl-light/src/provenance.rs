@@ -70,6 +70,12 @@ pub enum Extraction {
     IrradianceOptimization(FitReport),
     /// The probe's dominant compact light (`sun`).
     DominantLight,
+    /// A room's important light patches (Grosch 2005, section 3.3: `ibl room lights`), read as
+    /// directional lights seen from one point (`important-patches`).
+    ImportantPatches {
+        /// Patches in the area-light file.
+        patches: u32,
+    },
     /// A method this build does not know, named in a light file made elsewhere; its parameters
     /// are not kept.
     Unknown {
@@ -97,11 +103,15 @@ impl ParameterError {
     }
 }
 
+/// The method name of [`Extraction::ImportantPatches`].
+pub const IMPORTANT_PATCHES: &str = "important-patches";
+
 impl Extraction {
     /// The method's name in files (`median-cut`, ..., `sun`, or the unknown name as given).
     pub fn name(&self) -> &str {
         match self {
             Extraction::Unknown { name } => name,
+            Extraction::ImportantPatches { .. } => IMPORTANT_PATCHES,
             other => other.source().map_or("", LightSource::name),
         }
     }
@@ -117,7 +127,7 @@ impl Extraction {
                 LightSource::Method(Method::IrradianceOptimization)
             }
             Extraction::DominantLight => LightSource::Sun,
-            Extraction::Unknown { .. } => return None,
+            Extraction::ImportantPatches { .. } | Extraction::Unknown { .. } => return None,
         })
     }
 
@@ -139,6 +149,7 @@ impl Extraction {
         };
         match self {
             Extraction::MedianCut { splits } => named(&[("splits", f64::from(*splits))]),
+            Extraction::ImportantPatches { patches } => named(&[("patches", f64::from(*patches))]),
             Extraction::LightGen { restarts, seed } => {
                 named(&[("restarts", *restarts as f64), ("seed", *seed as f64)])
             }
@@ -166,11 +177,12 @@ impl Extraction {
         name: &str,
         parameters: &BTreeMap<String, f64>,
     ) -> Result<Extraction, ParameterError> {
-        let Ok(source) = name.parse::<LightSource>() else {
+        let source = name.parse::<LightSource>();
+        if source.is_err() && name != IMPORTANT_PATCHES {
             return Ok(Extraction::Unknown {
                 name: name.to_string(),
             });
-        };
+        }
         let number = |key: &str| -> Result<f64, ParameterError> {
             parameters.get(key).copied().ok_or_else(|| ParameterError {
                 method: name.to_string(),
@@ -189,6 +201,15 @@ impl Extraction {
                     problem: format!("must be a whole number (got {v})"),
                 })
             }
+        };
+        let Ok(source) = source else {
+            return Ok(Extraction::ImportantPatches {
+                patches: u32::try_from(whole("patches")?).map_err(|_| ParameterError {
+                    method: name.to_string(),
+                    parameter: "patches".to_string(),
+                    problem: "is too large".to_string(),
+                })?,
+            });
         };
         Ok(match source {
             LightSource::Sun => Extraction::DominantLight,
@@ -265,6 +286,7 @@ mod tests {
                 fit_normals: 4096,
             }),
             Extraction::DominantLight,
+            Extraction::ImportantPatches { patches: 32 },
         ];
         for run in runs {
             let back = Extraction::from_parameters(run.name(), &run.parameters());

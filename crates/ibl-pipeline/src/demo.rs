@@ -7,7 +7,8 @@
 //! ([`crate::demo_probe`]). Then it runs the comparison of [`crate::eval`] on the same probes
 //! (every extraction method, SH9 alone and LightGen lights with an SH9 ambient, N = 1 to 128,
 //! 20000 scoring normals) into `eval/`, and renders the example scenes (`renders/`,
-//! [`crate::demo_render`]). Everything lands in one folder with an `index.html` to look at and a
+//! [`crate::demo_render`]) and estimates the worked example's room (Grosch 2005: reflectance per
+//! group, the report, the important patches; `room/`, [`crate::demo_room`]). Everything lands in one folder with an `index.html` to look at and a
 //! `summary.json` for scripts ([`crate::demo_page`]).
 
 use std::path::{Path, PathBuf};
@@ -18,6 +19,7 @@ use ibl_light::{LightSource, Method};
 use crate::demo_paths::EVAL_DIR;
 use crate::demo_probe::{ProbeResult, demo_mappings, demo_probe};
 use crate::demo_render::{SceneResult, demo_renders};
+use crate::demo_room::{RoomResult, demo_room};
 use crate::error::{Context, PipelineError, Result};
 use crate::eval::{EvalSettings, evaluate};
 use crate::progress::Progress;
@@ -31,6 +33,9 @@ pub struct DemoOptions {
     pub probes: PathBuf,
     /// Folder of scene files to render.
     pub scenes: PathBuf,
+    /// Room file of the room section (the bundled `assets/rooms/apartment/room.toml`); none
+    /// leaves the section out.
+    pub room: Option<PathBuf>,
 }
 
 /// What the demo made.
@@ -42,6 +47,8 @@ pub struct Demo {
     pub report: ibl_eval::Report,
     /// Per scene.
     pub renders: Vec<SceneResult>,
+    /// The reconstructed room.
+    pub room: Option<RoomResult>,
 }
 
 /// Light counts of the demo's comparison: the powers of two 1 to 128. `ibl eval` also sweeps 256 by
@@ -128,10 +135,15 @@ pub fn demo(o: &DemoOptions, progress: &dyn Progress) -> Result<Demo> {
     let report = evaluate(&probes, &settings, &o.out.join(EVAL_DIR), progress)
         .context("comparing the light extraction methods")?;
     let renders = demo_renders(&o.scenes, &o.out, progress)?;
-    crate::demo_page::write_summary(&o.out, &results, &report, &renders)?;
+    let room = match &o.room {
+        Some(path) => Some(demo_room(path, &o.out, progress)?),
+        None => None,
+    };
+    crate::demo_page::write_summary(&o.out, &results, &report, &renders, room.as_ref())?;
     Ok(Demo {
         probes: results,
         report,
         renders,
+        room,
     })
 }

@@ -9,6 +9,7 @@ use serde::Serialize;
 use crate::demo_paths::EVAL_DIR;
 use crate::demo_probe::ProbeResult;
 use crate::demo_render::SceneResult;
+use crate::demo_room::{RoomResult, room_html};
 use crate::error::Result;
 
 /// The comparison section of `index.html`: links, the average plot and the lights-needed table.
@@ -73,16 +74,20 @@ pub fn write_summary(
     results: &[ProbeResult],
     report: &ibl_eval::Report,
     renders: &[SceneResult],
+    room: Option<&RoomResult>,
 ) -> Result<()> {
     #[derive(Serialize)]
     struct Summary<'a> {
         probes: &'a [ProbeResult],
         renders: &'a [SceneResult],
+        #[serde(skip_serializing_if = "Option::is_none")]
+        room: Option<&'a RoomResult>,
     }
     // Serialising plain data to a string cannot fail.
     let json = serde_json::to_string_pretty(&Summary {
         probes: results,
         renders,
+        room,
     })
     .unwrap_or_default();
     ibl_io::write_atomically(&out.join("summary.json"), json.as_bytes())?;
@@ -96,7 +101,8 @@ pub fn write_summary(
     let _ = write!(
         html,
         "<p>Every probe in every mapping below; then <a href=\"#eval\">the light extraction \
-         methods compared</a> (<a href=\"{EVAL_DIR}/{}\">report.md</a>).</p>",
+         methods compared</a> (<a href=\"{EVAL_DIR}/{}\">report.md</a>), the renders and \
+         <a href=\"#room\">the reconstructed room</a>.</p>",
         report.files.markdown
     );
     for r in results {
@@ -150,6 +156,9 @@ pub fn write_summary(
     }
     html.push_str(&eval_html(report));
     html.push_str(&renders_html(renders));
+    if let Some(room) = room {
+        html.push_str(&room_html(room));
+    }
     ibl_io::write_atomically(&out.join("index.html"), html.as_bytes())?;
     Ok(())
 }

@@ -10,6 +10,9 @@ pub const EVAL_DIR: &str = "eval";
 /// Sub-folder of the renders.
 pub const RENDER_DIR: &str = "renders";
 
+/// Sub-folder of the reconstructed room.
+pub const ROOM_DIR: &str = "room";
+
 /// `p` relative to `base` (for links in `index.html`).
 pub fn relative(base: &Path, p: &Path) -> String {
     p.strip_prefix(base).unwrap_or(p).display().to_string()

@@ -11,6 +11,7 @@ use ibl_io::IoError;
 use ibl_mapping::MappingError;
 use ibl_metrics::DifferenceError;
 use ibl_render::RenderError;
+use ibl_room::RoomError;
 use ibl_scene::DescriptionError;
 use ibl_sh::ShError;
 
@@ -50,6 +51,9 @@ pub enum PipelineError {
     /// A scene description.
     #[error(transparent)]
     Description(#[from] DescriptionError),
+    /// A room, marks file or room estimate (Grosch 2005).
+    #[error(transparent)]
+    Room(#[from] RoomError),
     /// An option the caller gave is out of range or contradicts another (the message says which
     /// and why): always the input's fault.
     #[error("{0}")]
@@ -79,6 +83,7 @@ impl PipelineError {
             PipelineError::Capture(e) => e.is_bad_input(),
             PipelineError::Difference(e) => e.is_bad_input(),
             PipelineError::Description(e) => e.is_bad_input(),
+            PipelineError::Room(e) => e.is_bad_input(),
             PipelineError::Parameter(_) => true,
             PipelineError::Context { source, .. } => source.is_bad_input(),
         }

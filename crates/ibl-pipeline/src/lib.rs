@@ -14,9 +14,12 @@
 //!   [`render`]: a scene rendered and composited;
 //! - [`eval`]: the comparison of the extraction methods as a report folder; [`compare`]: image
 //!   metrics between two files;
+//! - [`room_calibrate`], [`room_estimate`], [`room_lights`]: the reconstructed room of Grosch
+//!   2005 (marks to frame and scale, room and probe to reflectance and the report, the important
+//!   patches as an area-light file), on [`room_input`];
 //! - [`capture`]: brackets merged to HDR; [`capture_views`]: mirror balls and fisheye pairs;
 //! - [`demo`]: the main job on the bundled probes and scenes ([`demo_probe`], [`demo_render`],
-//!   [`demo_page`], [`demo_paths`]).
+//!   [`demo_page`], [`demo_paths`], [`demo_room`]).
 //!
 //! Errors are [`PipelineError`]s, split by cause; [`PipelineError::is_bad_input`] tells the
 //! caller's fault from ours.
@@ -30,6 +33,7 @@ pub mod demo_page;
 pub mod demo_paths;
 pub mod demo_probe;
 pub mod demo_render;
+pub mod demo_room;
 pub mod envmap_files;
 pub mod error;
 pub mod eval;
@@ -41,6 +45,10 @@ pub mod prefilter;
 pub mod preview;
 pub mod progress;
 pub mod render;
+pub mod room_calibrate;
+pub mod room_estimate;
+pub mod room_input;
+pub mod room_lights;
 pub mod sh;
 
 pub use envmap_files::EnvMapping;

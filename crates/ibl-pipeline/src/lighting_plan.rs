@@ -8,6 +8,9 @@
 //! extracted from, so the scene's `radiance_scale` (which the scene applies to its probe) is
 //! applied to the file's lights too; lights extracted here come from the already scaled probe.
 //!
+//! An area-light file of a room's important patches is read as directional lights seen from the
+//! probe's centre (far field: `I = L A cos / r^2` per patch), in the probe's frame.
+//!
 //! Lights are in the probe's frame; `ibl_render::Lighting` turns them by `world_from_probe`.
 
 use std::path::Path;
@@ -73,8 +76,16 @@ impl LightingPlan {
 
     /// Uses the lights of the light file `path` (see the module doc), with the probe's
     /// `radiance_scale` applied.
+    /// An area-light file (`iblkit.area-lights/1`, `ibl room lights`) is read as directional
+    /// lights seen from the probe's centre (`AreaLightsFile::distant_lights`): the scene's origin
+    /// stands where the probe stood in the room.
     pub fn with_light_file(self, path: &Path, radiance_scale: f32) -> Result<LightingPlan> {
-        let set = ibl_io::light_file::read_light_set(path)?;
+        let is_area = ibl_io::area_light_file::is_area_lights_file(path)?;
+        let set = if is_area {
+            ibl_io::area_light_file::read_area_lights_file(path)?.distant_lights()
+        } else {
+            ibl_io::light_file::read_light_set(path)?
+        };
         Ok(LightingPlan {
             given: Some(set.scaled(f64::from(radiance_scale))),
             ..self

@@ -1,0 +1,171 @@
+//! The demo's room (Grosch 2005 section 3, `docs/ROOMS.md`): the worked example's room file
+//! (`assets/rooms/apartment`, reconstructed from marks on the bundled apartment probe) estimated
+//! by [`crate::room_estimate`] into `room/`: the Table-1 report, reflectance per group, the
+//! important patches as an area-light file, and the three pictures; and the section of the
+//! demo's page that shows them.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use serde::Serialize;
+
+use crate::demo_paths::ROOM_DIR;
+use crate::error::{Context, Result};
+use crate::progress::Progress;
+use crate::room_estimate::{SamplingOptions, estimate_room, report, write_pictures};
+use crate::room_lights::write_lights;
+
+/// Important patches the demo lists and exports.
+pub const DEMO_IMPORTANT_PATCHES: usize = 16;
+
+/// One group's row of the demo's room table.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RoomGroupRow {
+    /// Group name.
+    pub name: String,
+    /// Estimated reflectance (surfaces), linear RGB.
+    pub reflectance: Option<[f32; 3]>,
+    /// Whether it comes from the group's own seen patches (else the mean of the others).
+    pub estimated: bool,
+    /// Fraction of the group's area the probe sees.
+    pub seen_area_fraction: f32,
+}
+
+/// What the demo's room made.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RoomResult {
+    /// The room file.
+    pub room: String,
+    /// Patches.
+    pub patches: usize,
+    /// Iterations of steps 1 to 5 and whether they converged.
+    pub iterations: usize,
+    /// Whether the last iteration changed every reflectance by less than the tolerance.
+    pub converged: bool,
+    /// Seconds of the analysis.
+    pub seconds: f64,
+    /// Per group.
+    pub groups: Vec<RoomGroupRow>,
+    /// Share of the room's luminous flux in the important patches.
+    pub important_flux_fraction: f64,
+    /// Paths relative to the demo folder: report.md, report.json, lights.json, rho-panorama.png,
+    /// overlay.png, cutaway.png.
+    pub files: Vec<String>,
+}
+
+/// Estimates the room file `room` into `out/room/`.
+pub fn demo_room(room: &Path, out: &Path, progress: &dyn Progress) -> Result<RoomResult> {
+    let dir = out.join(ROOM_DIR);
+    ibl_io::create_dir_all(&dir)?;
+    let name = room.display().to_string();
+    let sampling = SamplingOptions::default();
+    let estimated = estimate_room(room, &sampling, progress).context(name.clone())?;
+    let (report, lights) = report(&estimated, DEMO_IMPORTANT_PATCHES);
+    ibl_io::write_atomically(&dir.join("report.json"), report.to_json()?.as_bytes())?;
+    ibl_io::write_atomically(&dir.join("report.md"), report.to_markdown().as_bytes())?;
+    write_pictures(
+        &dir,
+        &estimated.input.room,
+        &estimated.probe,
+        &estimated.analysis,
+    )?;
+    // The light file as `ibl room lights` writes it.
+    write_lights(
+        &estimated,
+        room,
+        &dir.join("lights.json"),
+        DEMO_IMPORTANT_PATCHES,
+        progress,
+    )?;
+    let estimate = &estimated.analysis.estimate;
+    Ok(RoomResult {
+        room: name,
+        patches: estimated.input.room.patches.len(),
+        iterations: estimate.iterations.len(),
+        converged: estimate.converged,
+        seconds: estimated.seconds,
+        groups: estimate
+            .groups
+            .iter()
+            .map(|g| RoomGroupRow {
+                name: g.name.clone(),
+                reflectance: g.reflectance,
+                estimated: g.estimated,
+                seen_area_fraction: g.seen_area_fraction,
+            })
+            .collect(),
+        important_flux_fraction: lights.important_flux_fraction,
+        files: [
+            "report.md",
+            "report.json",
+            "lights.json",
+            "rho-panorama.png",
+            "overlay.png",
+            "cutaway.png",
+        ]
+        .iter()
+        .map(|f| format!("{ROOM_DIR}/{f}"))
+        .collect(),
+    })
+}
+
+/// The room section of the demo's `index.html`.
+pub fn room_html(r: &RoomResult) -> String {
+    let mut html = format!(
+        "<h1 id=room>The reconstructed room</h1><p>Grosch 2005, section 3, on the bundled \
+         apartment probe (<code>{}</code>, made from marked lines by <code>ibl room calibrate</code>; \
+         the method and its validation are in the repository's <code>docs/ROOMS.md</code>): {} patches, reflectance \
+         <code>rho = B / E</code> by radiosity in {} iterations ({}), {:.1} s. The {} important \
+         patches carry {:.1} % of the room's luminous flux (<a href=\"{ROOM_DIR}/lights.json\">\
+         lights.json</a>, for <code>ibl render --lights</code>). \
+         <a href=\"{ROOM_DIR}/report.md\">report.md</a> &middot; \
+         <a href=\"{ROOM_DIR}/report.json\">report.json</a></p>",
+        r.room,
+        r.patches,
+        r.iterations,
+        if r.converged {
+            "converged"
+        } else {
+            "not converged"
+        },
+        r.seconds,
+        DEMO_IMPORTANT_PATCHES,
+        100.0 * r.important_flux_fraction
+    );
+    html.push_str("<table><tr><th>group</th><th>rho (R, G, B)</th><th>seen</th><th>from</th></tr>");
+    for g in &r.groups {
+        let rho = g
+            .reflectance
+            .map(|[a, b, c]| format!("{a:.3}, {b:.3}, {c:.3}"))
+            .unwrap_or_else(|| "light".into());
+        let _ = write!(
+            html,
+            "<tr><td>{}</td><td>{rho}</td><td>{:.0} %</td><td>{}</td></tr>",
+            g.name,
+            100.0 * g.seen_area_fraction,
+            if g.estimated {
+                "its patches"
+            } else {
+                "the others' mean"
+            }
+        );
+    }
+    html.push_str("</table>");
+    for (file, caption) in [
+        (
+            "rho-panorama.png",
+            "patches coloured by reflectance, hidden ones hatched",
+        ),
+        ("overlay.png", "the model's edges over the probe"),
+        (
+            "cutaway.png",
+            "the room from above, coloured by reflectance",
+        ),
+    ] {
+        let _ = write!(
+            html,
+            "<figure><img class=wide src=\"{ROOM_DIR}/{file}\"><figcaption>{caption}</figcaption></figure>"
+        );
+    }
+    html
+}
