@@ -28,7 +28,7 @@ pub mod resample;
 pub mod taps;
 
 pub use cube::{CUBE_FACE_NAMES, join_cube_faces, split_cube_faces};
-pub use error::MappingError;
+pub use error::{MappingError, with_article};
 pub use mapping::{CubeLayout, MAPPING_NAMES, Mapping};
 pub use power::{power, try_power};
 pub use projection::Projection;

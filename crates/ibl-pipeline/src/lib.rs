@@ -5,6 +5,7 @@
 //! Progress and notes go through the [`Progress`] the front end supplies; nothing here prints.
 //!
 //! - [`envmap_files`]: environment maps on disk, one file in any mapping or six cube faces;
+//!   [`probe_input`]: the one probe loader (mapping detected or given, converted to lat-long);
 //! - [`info`]: probe statistics; [`convert`]: mappings, formats, rotations, frame presets;
 //!   [`preview`]: tone-mapped pictures; [`irradiance`]: irradiance on normals and as maps;
 //! - [`lights`]: light sets in every format, hybrid lighting, overlays; [`sh`]: spherical
@@ -13,9 +14,11 @@
 //!   [`render`]: a scene rendered and composited;
 //! - [`eval`]: the comparison of the extraction methods as a report folder; [`compare`]: image
 //!   metrics between two files;
-//! - [`capture`]: brackets merged to HDR; [`capture_views`]: mirror balls and fisheye pairs;
+//! - [`capture`]: brackets merged to HDR ([`exposure_list`]: the time files it reads); [`capture_views`]: mirror balls and fisheye pairs;
 //! - [`demo`]: the main job on the bundled probes and scenes ([`demo_probe`], [`demo_render`],
 //!   [`demo_page`], [`demo_paths`]).
+//!
+//! Every output path is checked before the work starts ([`output_paths`]).
 //!
 //! Errors are [`PipelineError`]s, split by cause; [`PipelineError::is_bad_input`] tells the
 //! caller's fault from ours.
@@ -32,11 +35,14 @@ pub mod demo_render;
 pub mod envmap_files;
 pub mod error;
 pub mod eval;
+pub mod exposure_list;
 pub mod info;
 pub mod irradiance;
 pub mod lighting_plan;
 pub mod lights;
+pub mod output_paths;
 pub mod preview;
+pub mod probe_input;
 pub mod progress;
 pub mod render;
 pub mod sh;
@@ -44,4 +50,5 @@ pub mod sh;
 pub use envmap_files::EnvMapping;
 pub use error::{PipelineError, Result};
 pub use lighting_plan::LightingPlan;
+pub use probe_input::{LoadedProbe, ProbeDetection, load_probe};
 pub use progress::{Progress, Silent};
