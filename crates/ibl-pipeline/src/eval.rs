@@ -253,7 +253,7 @@ pub fn evaluate(
     let inputs: Vec<&Path> = probes.iter().map(|p| p.path.as_path()).collect();
     // Refuse before the (long) sweep if any planned output is an input.
     for relative in planned_outputs(&probes, settings) {
-        crate::output_paths::check_output_path(&out.join(relative), &inputs)?;
+        ibl_io::ensure_output_is_not_input(&out.join(relative), &inputs)?;
     }
     progress.begin("eval", 1);
     let on_progress = |p: SweepProgress| {
