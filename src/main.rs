@@ -7,6 +7,7 @@
 
 mod cmd;
 mod failure;
+mod probe_arg;
 mod progress;
 mod values;
 

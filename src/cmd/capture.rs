@@ -13,8 +13,18 @@ use ibl_pipeline::capture::{ExposureTimes, MergeJob, Response, merge_bracket};
 use ibl_pipeline::capture_views::{
     BallJob, BallView, FisheyeJob, default_yaws, stitch_fisheyes, unwrap_balls,
 };
+use ibl_pipeline::exposure_list::TimeUnit;
 
 use crate::values::{self, AngleList, ExposureList, ResponseArg};
+
+/// What the numbers of a `--times-file` are.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum TimeUnitArg {
+    /// Seconds (`1/250` is 4 ms).
+    Seconds,
+    /// 1 / seconds, as OpenCV's list.txt holds them (`250` is 4 ms).
+    InverseSeconds,
+}
 
 /// Arguments of `ibl capture`.
 #[derive(Args)]
@@ -51,7 +61,13 @@ Examples:
   ibl capture merge IMG_1*.jpg -o probe.exr                  times from EXIF, response recovered
   ibl capture merge a.png b.png c.png --times 1/250,1/60,1/15 -o hdr.exr --response-out curve.csv
   ibl capture merge *.png --times-file times.txt --response linear -o hdr.exr
+  ibl capture merge memorial*.png --times-file list.txt -o hdr.exr   OpenCV's list (1/seconds)
   ibl capture merge *.jpg -o hdr.exr --response curve.csv --align --deghost
+
+--times-file takes numbers or fractions in image order, or `name value` lines matched to the
+images by file name: OpenCV's list.txt (values 1/seconds, as its HDR tutorial reads them) and
+`name seconds` lists such as exposure_times_seconds.txt. A two-column file's unit comes from
+--times-unit, else from its name (list.txt: inverse-seconds; a name with `seconds`: seconds).
 
 Writes OUT, OUT's .png preview and (recovered or not) the response curve as
 <OUT stem>-response.csv/.svg/.png unless --response-out names the CSV.")]
@@ -65,9 +81,14 @@ pub struct MergeArgs {
     /// Exposure times in seconds, one per image in order (`1/250,1/60,0.25`); overrides EXIF.
     #[arg(long, value_name = "LIST", value_parser = values::exposure_times)]
     pub times: Option<ExposureList>,
-    /// A file of exposure times (numbers or fractions, separated by commas, spaces or lines).
+    /// A file of exposure times: numbers or fractions in image order, or `name value` lines
+    /// (OpenCV's list.txt, `name seconds` lists), matched by file name.
     #[arg(long, value_name = "FILE")]
     pub times_file: Option<PathBuf>,
+    /// The unit of the --times-file values (default: seconds, or what a two-column file's name
+    /// says: list.txt is OpenCV's inverse seconds).
+    #[arg(long, value_enum, value_name = "UNIT")]
+    pub times_unit: Option<TimeUnitArg>,
     /// The camera response: `recover` (Debevec & Malik), `linear` (RAW-like data) or a CSV file
     /// written by --response-out.
     #[arg(
@@ -185,7 +206,13 @@ fn run_merge(args: &MergeArgs) -> anyhow::Result<()> {
         output: args.output.clone(),
         times: match (&args.times, &args.times_file) {
             (Some(list), _) => ExposureTimes::Given(list.0.clone()),
-            (None, Some(file)) => ExposureTimes::File(file.clone()),
+            (None, Some(file)) => ExposureTimes::File(
+                file.clone(),
+                args.times_unit.map(|u| match u {
+                    TimeUnitArg::Seconds => TimeUnit::Seconds,
+                    TimeUnitArg::InverseSeconds => TimeUnit::InverseSeconds,
+                }),
+            ),
             (None, None) => ExposureTimes::Exif,
         },
         response: match &args.response {

@@ -39,13 +39,16 @@ pub enum CompressionArg {
 /// Arguments of `ibl convert`.
 #[derive(Args)]
 #[command(after_help = "\
-Mappings: latlong, angular, mirror-ball, cube-hcross, cube-vcross, cube-strip, cube-faces
-          (six files: OUT may contain {face}, else _px.._nz is added), fisheye, dual-fisheye.
+Mappings: latlong, angular, mirror-ball, cube-hcross, cube-vcross, cube-strip (6:1), cube-vstrip
+          (1:6), cube-faces (six files: OUT may contain {face}, else _px.._nz is added), fisheye,
+          dual-fisheye. Without --from the input's mapping is detected from its shape (2:1, 1:1,
+          4:3, 3:4, 6:1, 1:6); other shapes need --from. Without --to (and no --width, --rotate
+          or --frame) only the file format changes: the pixels pass through unchanged.
 
 Examples:
   ibl convert probe.hdr probe.exr                         format only
   ibl convert probe.exr cross.exr --to cube-hcross        lat-long to a cube cross
-  ibl convert probe.exr 'sky_{face}.hdr' --to cube-faces  six face files
+  ibl convert probe.exr 'sky_{face}.hdr' --to cube-faces --face-size 256   six 256 x 256 files
   ibl convert ball.png probe.exr --from mirror-ball --to latlong --width 1024
   ibl convert probe.exr turned.exr --rotate 90,0,0        yaw 90 deg: what was ahead is now left
   ibl convert probe.exr three.hdr --frame threejs         layout for three.js's equirect loader
@@ -61,9 +64,14 @@ pub struct ConvertArgs {
     /// Mapping of the output (default: the input's).
     #[arg(long, value_name = "MAPPING")]
     pub to: Option<String>,
-    /// Output width in pixels (height follows from the mapping).
+    /// Output width in pixels (height follows from the mapping); with `--to cube-faces` the
+    /// width of each face file.
     #[arg(long, value_name = "W")]
     pub width: Option<usize>,
+    /// Face size in pixels of a cube output (cube-hcross, cube-vcross, cube-strip, cube-vstrip,
+    /// cube-faces), instead of --width.
+    #[arg(long, value_name = "S")]
+    pub face_size: Option<usize>,
     /// Rotate the environment: yaw,pitch,roll in degrees (about +Y, +X, +Z; roll first).
     #[arg(long, value_name = "Y,P,R", allow_hyphen_values = true, value_parser = values::rotation)]
     pub rotate: Option<EulerDegrees>,
@@ -117,18 +125,19 @@ pub fn run(args: &ConvertArgs) -> anyhow::Result<()> {
         from: parse(&args.from, args.from_fov.unwrap_or(args.fov))?,
         to: parse(&args.to, args.fov)?,
         width: args.width,
+        face_size: args.face_size,
         rotation: args.rotate.unwrap_or_default(),
         frame: args.frame,
         from_frame: args.from_frame,
         exr: exr_options(args.exr_precision, args.exr_compression),
     };
     let converted = convert(&options, &Bars::default())?;
-    for p in &converted.files {
+    for f in &converted.files {
         eprintln!(
             "wrote {} ({} x {}, {})",
-            p.display(),
-            converted.width,
-            converted.height,
+            f.path.display(),
+            f.width,
+            f.height,
             converted.mapping
         );
     }

@@ -8,6 +8,7 @@ use ibl_eval::Report;
 use ibl_eval::report::LightsNeeded;
 use ibl_pipeline::eval::{DEFAULT_COUNTS, EvalSettings, evaluate};
 
+use crate::probe_arg::ProbeMappingArgs;
 use crate::progress::Bars;
 use crate::values::{self, ModelList};
 
@@ -22,9 +23,11 @@ Examples:
 Writes DIR/report.json, report.csv, report.md (lights needed for 1 % and 5 % error), error-vs-N
 plots (plots/, SVG and PNG), irradiance spheres (spheres/) and light overlays (overlays/).")]
 pub struct EvalArgs {
-    /// Lat-long probes (.exr, .hdr, .pfm, .png, .jpg).
+    /// Probes (.exr, .hdr, .pfm, .png, .jpg), lat-long or any mapping `--mapping` names.
     #[arg(required = true, value_name = "PROBE")]
     pub probes: Vec<PathBuf>,
+    #[command(flatten)]
+    pub probe_mapping: ProbeMappingArgs,
     /// Methods: `all` (the five light methods), or a comma-separated list of median-cut,
     /// adaptive-median-cut, lightgen, variance-minimization, irradiance-optimization, sun (the
     /// dominant light, N = 1), any of them with an SH ambient (`lightgen+sh3`, `sun+sh3`: 1 sun +
@@ -87,13 +90,14 @@ pub fn print_lights_needed(report: &Report) {
 
 /// Runs `ibl eval`.
 pub fn run(args: &EvalArgs) -> anyhow::Result<()> {
-    let settings = EvalSettings::new(
+    let mut settings = EvalSettings::new(
         args.methods.0.clone(),
         args.counts.clone(),
         args.normals,
         args.seed,
         args.overlay_n,
     )?;
+    settings.mapping = args.probe_mapping.mapping()?;
     let report = evaluate(&args.probes, &settings, &args.out, &Bars::default())?;
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);

@@ -8,6 +8,7 @@ use ibl_pipeline::EnvMapping;
 use ibl_pipeline::irradiance::{CHECK_NORMALS, IrradianceMethod, IrradianceOptions, irradiance};
 use ibl_sh::Window;
 
+use crate::probe_arg::ProbeMappingArgs;
 use crate::progress::Bars;
 use crate::values;
 
@@ -32,8 +33,10 @@ Examples:
   ibl irradiance probe.exr -o irr.exr --method sh --bands 3           the usual SH9 irradiance map
   ibl irradiance probe.exr -o irr.hdr --to cube-hcross --width 256    cube cross, faces 64 x 64")]
 pub struct IrradianceArgs {
-    /// Lat-long probe (.exr, .hdr, .pfm).
+    /// The probe (.exr, .hdr, .pfm, .png, .jpg), lat-long or any mapping `--mapping` names.
     pub probe: PathBuf,
+    #[command(flatten)]
+    pub probe_mapping: ProbeMappingArgs,
     /// Exact (every pixel), fast (reduced probe) or sh (Lambert-convolved spherical harmonics).
     #[arg(long, value_enum, default_value = "exact")]
     pub method: MethodArg,
@@ -52,8 +55,8 @@ pub struct IrradianceArgs {
     /// Output irradiance map (.exr, .hdr, .pfm; `{face}` pattern with `--to cube-faces`).
     #[arg(short = 'o', long = "output", value_name = "FILE")]
     pub output: Option<PathBuf>,
-    /// Mapping of the irradiance map: latlong, cube-hcross, cube-vcross, cube-strip, cube-faces,
-    /// angular, mirror-ball.
+    /// Mapping of the irradiance map: latlong, cube-hcross, cube-vcross, cube-strip, cube-vstrip,
+    /// cube-faces, angular, mirror-ball.
     #[arg(long, default_value = "latlong", value_name = "MAPPING")]
     pub to: String,
     /// Width of the irradiance map in pixels (irradiance is smooth: small maps suffice).
@@ -68,6 +71,7 @@ pub struct IrradianceArgs {
 pub fn run(args: &IrradianceArgs) -> anyhow::Result<()> {
     let options = IrradianceOptions {
         probe: args.probe.clone(),
+        mapping: args.probe_mapping.mapping()?,
         method: match args.method {
             MethodArg::Exact => IrradianceMethod::Exact,
             MethodArg::Fast => IrradianceMethod::Fast,

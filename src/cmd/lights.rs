@@ -9,6 +9,7 @@ use ibl_extract::ExtractOptions;
 use ibl_light::{LightSet, Method};
 use ibl_pipeline::lights::{LightsOptions, lights};
 
+use crate::probe_arg::ProbeMappingArgs;
 use crate::progress::Bars;
 use crate::values;
 
@@ -66,8 +67,10 @@ Examples:
   ibl lights sky.exr -n 1 --method irradiance-optimization --ambient-sh 3 -o sun+sh9.json"
 )]
 pub struct LightsArgs {
-    /// Lat-long probe (.exr, .hdr, .pfm).
+    /// The probe (.exr, .hdr, .pfm, .png, .jpg), lat-long or any mapping `--mapping` names.
     pub probe: PathBuf,
+    #[command(flatten)]
+    pub probe_mapping: ProbeMappingArgs,
     /// Number of lights (median cut: a power of two; every other method: any N >= 1).
     #[arg(short = 'n', long, value_name = "N")]
     pub count: usize,
@@ -107,6 +110,7 @@ pub struct LightsArgs {
 pub fn run(args: &LightsArgs) -> anyhow::Result<()> {
     let options = LightsOptions {
         probe: args.probe.clone(),
+        mapping: args.probe_mapping.mapping()?,
         count: args.count,
         method: args.method.method(),
         seed: args.seed,
@@ -121,6 +125,7 @@ pub fn run(args: &LightsArgs) -> anyhow::Result<()> {
     if args.json {
         let summary = serde_json::json!({
             "probe": args.probe.display().to_string(),
+            "probe_input": result.probe,
             "method": options.method.name(),
             "n": set.lights.len(),
             "requested": args.count,

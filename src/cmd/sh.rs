@@ -8,6 +8,7 @@ use ibl_io::{ShFileFormat, ShQuantity};
 use ibl_pipeline::sh::{ShOptions, ShSource, spherical_harmonics};
 use ibl_sh::Window;
 
+use crate::probe_arg::ProbeMappingArgs;
 use crate::progress::Bars;
 use crate::values;
 
@@ -30,8 +31,10 @@ Examples:
   ibl sh probe.exr --format threejs -o probe.json    three.js ObjectLoader / LightProbe.fromJSON
   ibl sh --from filament sh.txt --format unity       convert between tools")]
 pub struct ShArgs {
-    /// Lat-long probe (.exr, .hdr, .pfm), or with `--from` an SH file.
+    /// The probe (lat-long or any mapping `--mapping` names), or with `--from` an SH file.
     pub input: PathBuf,
+    #[command(flatten)]
+    pub probe_mapping: ProbeMappingArgs,
     /// Read `INPUT` as an SH file in this format instead of projecting a probe.
     #[arg(long, value_name = "FORMAT", value_parser = values::sh_format)]
     pub from: Option<ShFileFormat>,
@@ -57,7 +60,7 @@ pub fn run(args: &ShArgs) -> anyhow::Result<()> {
     let options = ShOptions {
         source: match args.from {
             Some(format) => ShSource::File(args.input.clone(), format),
-            None => ShSource::Probe(args.input.clone()),
+            None => ShSource::Probe(args.input.clone(), args.probe_mapping.mapping()?),
         },
         format: args.format,
         bands: args.bands,

@@ -6,9 +6,17 @@
 use std::path::PathBuf;
 use std::process::{Command, Output};
 
-/// Runs the built `ibl` binary with `args`.
+/// The `ibl` binary under test: the one cargo built, or `IBL_TEST_BIN` when set (to run a new
+/// test against an older build and see it fail, as issue 13 asks of every fix).
+pub fn ibl_binary() -> PathBuf {
+    std::env::var_os("IBL_TEST_BIN")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_BIN_EXE_ibl")))
+}
+
+/// Runs the `ibl` binary under test with `args`.
 pub fn ibl(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_ibl"))
+    Command::new(ibl_binary())
         .args(args)
         .output()
         .expect("run ibl")

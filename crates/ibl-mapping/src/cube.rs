@@ -24,6 +24,7 @@
 //! ```text
 //! horizontal cross 4x3      vertical cross 3x4        horizontal strip 6x1
 //!      .  +Y  .   .              .  +Y  .              +X -X +Y -Y +Z -Z
+//!                                                      (vertical strip 1x6: the same, top down)
 //!     -X  +Z  +X  -Z            -X  +Z  +X
 //!      .  -Y  .   .              .  -Y  .
 //!                                .  -Z* .   (* rotated 180 degrees)
@@ -73,6 +74,7 @@ impl CubeLayout {
                 (1, 3, true),
             ][face % 6],
             CubeLayout::HorizontalStrip => (face % 6, 0, false),
+            CubeLayout::VerticalStrip => (0, face % 6, false),
         }
     }
 

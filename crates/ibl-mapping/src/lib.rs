@@ -40,7 +40,7 @@ pub mod taps;
 pub use cube::{CUBE_FACE_NAMES, join_cube_faces, split_cube_faces};
 pub use cube_pyramid::CubePyramid;
 pub use dfg::{Dfg, DfgLayout};
-pub use error::MappingError;
+pub use error::{MappingError, with_article};
 pub use ggx::EngineTarget;
 pub use mapping::{CubeLayout, MAPPING_NAMES, Mapping};
 pub use power::{power, try_power};

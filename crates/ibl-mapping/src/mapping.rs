@@ -29,6 +29,9 @@ pub enum CubeLayout {
     VerticalCross,
     /// 6 x 1 cells in the order `+X -X +Y -Y +Z -Z`.
     HorizontalStrip,
+    /// 1 x 6 cells, top to bottom in the order `+X -X +Y -Y +Z -Z` (cmft's `vstrip`, the "1x6"
+    /// strips of Unity and Marmoset).
+    VerticalStrip,
 }
 
 /// A parameterisation of the sphere of directions by an image.
@@ -57,13 +60,14 @@ pub enum Mapping {
 }
 
 /// The canonical names of every mapping, for help texts.
-pub const MAPPING_NAMES: [&str; 8] = [
+pub const MAPPING_NAMES: [&str; 9] = [
     "latlong",
     "angular",
     "mirror-ball",
     "cube-hcross",
     "cube-vcross",
     "cube-strip",
+    "cube-vstrip",
     "fisheye",
     "dual-fisheye",
 ];
@@ -79,7 +83,7 @@ fn fov_text(fov: f32) -> String {
 
 impl Mapping {
     /// The mapping's name: `latlong`, `angular`, `mirror-ball`, `cube-hcross`, `cube-vcross`,
-    /// `cube-strip`, `fisheye-<fov>`, `dual-fisheye-<fov>` (e.g. `dual-fisheye-195`). Every name
+    /// `cube-strip`, `cube-vstrip`, `fisheye-<fov>`, `dual-fisheye-<fov>` (e.g. `dual-fisheye-195`). Every name
     /// is accepted back by [`Mapping::parse`].
     pub fn name(&self) -> String {
         match self {
@@ -110,9 +114,10 @@ impl Mapping {
                 Mapping::Cube(CubeLayout::HorizontalCross)
             }
             "cube-vcross" | "vcross" | "vertical-cross" => Mapping::Cube(CubeLayout::VerticalCross),
-            "cube-strip" | "strip" | "hstrip" | "horizontal-strip" => {
+            "cube-strip" | "strip" | "hstrip" | "horizontal-strip" | "cube-hstrip" => {
                 Mapping::Cube(CubeLayout::HorizontalStrip)
             }
+            "cube-vstrip" | "vstrip" | "vertical-strip" => Mapping::Cube(CubeLayout::VerticalStrip),
             "fisheye" => Mapping::Fisheye { fov_deg: fov },
             "dual-fisheye" | "dualfisheye" | "dual" => Mapping::DualFisheye { fov_deg: fov },
             _ => return None,
@@ -141,22 +146,28 @@ impl Mapping {
         Ok(())
     }
 
-    /// Guesses the mapping from the aspect ratio alone: 2:1 lat-long, 1:1 angular, 4:3 horizontal
-    /// cross, 3:4 vertical cross, 6:1 horizontal strip, anything else lat-long.
-    pub fn guess_from_shape(width: usize, height: usize) -> Mapping {
+    /// Detects the mapping from the aspect ratio alone: 2:1 lat-long, 1:1 angular (a mirror ball
+    /// is square too: shape cannot tell them apart), 4:3 horizontal cross, 3:4 vertical cross,
+    /// 6:1 horizontal strip, 1:6 vertical strip; `None` for any other shape (an empty image included), which no
+    /// caller may take for lat-long without saying so.
+    pub fn detect_from_shape(width: usize, height: usize) -> Option<Mapping> {
         let (w, h) = (width as u128, height as u128);
-        if w == 0 || h == 0 || w == 2 * h {
-            Mapping::LatLong
+        if w == 0 || h == 0 {
+            None
+        } else if w == 2 * h {
+            Some(Mapping::LatLong)
         } else if w == h {
-            Mapping::Angular
+            Some(Mapping::Angular)
         } else if 3 * w == 4 * h {
-            Mapping::Cube(CubeLayout::HorizontalCross)
+            Some(Mapping::Cube(CubeLayout::HorizontalCross))
         } else if 4 * w == 3 * h {
-            Mapping::Cube(CubeLayout::VerticalCross)
+            Some(Mapping::Cube(CubeLayout::VerticalCross))
         } else if w == 6 * h {
-            Mapping::Cube(CubeLayout::HorizontalStrip)
+            Some(Mapping::Cube(CubeLayout::HorizontalStrip))
+        } else if 6 * w == h {
+            Some(Mapping::Cube(CubeLayout::VerticalStrip))
         } else {
-            Mapping::LatLong
+            None
         }
     }
 
@@ -229,27 +240,30 @@ impl fmt::Display for Mapping {
 
 impl CubeLayout {
     /// Every layout, in a stable order.
-    pub const ALL: [CubeLayout; 3] = [
+    pub const ALL: [CubeLayout; 4] = [
         CubeLayout::HorizontalCross,
         CubeLayout::VerticalCross,
         CubeLayout::HorizontalStrip,
+        CubeLayout::VerticalStrip,
     ];
 
-    /// The layout's mapping name: `cube-hcross`, `cube-vcross`, `cube-strip`.
+    /// The layout's mapping name: `cube-hcross`, `cube-vcross`, `cube-strip`, `cube-vstrip`.
     pub fn name(self) -> &'static str {
         match self {
             CubeLayout::HorizontalCross => "cube-hcross",
             CubeLayout::VerticalCross => "cube-vcross",
             CubeLayout::HorizontalStrip => "cube-strip",
+            CubeLayout::VerticalStrip => "cube-vstrip",
         }
     }
 
-    /// The grid of cells as `(columns, rows)`: 4 x 3, 3 x 4 or 6 x 1.
+    /// The grid of cells as `(columns, rows)`: 4 x 3, 3 x 4, 6 x 1 or 1 x 6.
     pub fn grid(self) -> (usize, usize) {
         match self {
             CubeLayout::HorizontalCross => (4, 3),
             CubeLayout::VerticalCross => (3, 4),
             CubeLayout::HorizontalStrip => (6, 1),
+            CubeLayout::VerticalStrip => (1, 6),
         }
     }
 }
@@ -328,23 +342,31 @@ mod tests {
     }
 
     #[test]
-    fn shapes_are_guessed_and_checked() {
-        assert_eq!(Mapping::guess_from_shape(512, 256), Mapping::LatLong);
-        assert_eq!(Mapping::guess_from_shape(300, 300), Mapping::Angular);
+    fn shapes_are_detected_and_checked() {
+        let detect = Mapping::detect_from_shape;
+        assert_eq!(detect(512, 256), Some(Mapping::LatLong));
+        assert_eq!(detect(300, 300), Some(Mapping::Angular));
         assert_eq!(
-            Mapping::guess_from_shape(512, 384),
-            Mapping::Cube(CubeLayout::HorizontalCross)
+            detect(512, 384),
+            Some(Mapping::Cube(CubeLayout::HorizontalCross))
         );
         assert_eq!(
-            Mapping::guess_from_shape(384, 512),
-            Mapping::Cube(CubeLayout::VerticalCross)
+            detect(384, 512),
+            Some(Mapping::Cube(CubeLayout::VerticalCross))
         );
         assert_eq!(
-            Mapping::guess_from_shape(768, 128),
-            Mapping::Cube(CubeLayout::HorizontalStrip)
+            detect(768, 128),
+            Some(Mapping::Cube(CubeLayout::HorizontalStrip))
         );
-        assert_eq!(Mapping::guess_from_shape(0, 0), Mapping::LatLong);
-        assert_eq!(Mapping::guess_from_shape(usize::MAX, 3), Mapping::LatLong);
+        // Issue 13: a 2:3 photo and an empty image are no mapping, never lat-long.
+        // Issue 13: a 1:6 strip is a cube map, not a lat-long smear.
+        assert_eq!(
+            detect(64, 384),
+            Some(Mapping::Cube(CubeLayout::VerticalStrip))
+        );
+        assert_eq!(detect(400, 600), None);
+        assert_eq!(detect(0, 0), None);
+        assert_eq!(detect(usize::MAX, 3), None);
         assert!(
             Mapping::Cube(CubeLayout::HorizontalCross)
                 .check_shape(512, 384)

@@ -360,6 +360,7 @@ mod tests {
             (Mapping::Cube(CubeLayout::HorizontalCross), 64, 48),
             (Mapping::Cube(CubeLayout::VerticalCross), 48, 64),
             (Mapping::Cube(CubeLayout::HorizontalStrip), 96, 16),
+            (Mapping::Cube(CubeLayout::VerticalStrip), 16, 96),
             (Mapping::Fisheye { fov_deg: 360.0 }, 40, 40),
             (Mapping::DualFisheye { fov_deg: 195.0 }, 80, 40),
         ]

@@ -26,6 +26,7 @@ fn all_mappings() -> Vec<(Mapping, usize, usize)> {
         (Mapping::Cube(CubeLayout::HorizontalCross), 256, 192),
         (Mapping::Cube(CubeLayout::VerticalCross), 192, 256),
         (Mapping::Cube(CubeLayout::HorizontalStrip), 384, 64),
+        (Mapping::Cube(CubeLayout::VerticalStrip), 64, 384),
         (Mapping::Fisheye { fov_deg: 360.0 }, 200, 200),
         (Mapping::DualFisheye { fov_deg: 195.0 }, 400, 200),
     ]
@@ -509,6 +510,7 @@ fn cube_layout_cells() {
     );
     assert_eq!(CubeLayout::VerticalCross.cell(5), (1, 3, true));
     assert_eq!(CubeLayout::HorizontalStrip.cell(3), (3, 0, false));
+    assert_eq!(CubeLayout::VerticalStrip.cell(3), (0, 3, false));
     let m = Mapping::Cube(hc);
     assert!(m.pixel_dir(64, 48, 8.0, 8.0).is_none(), "unused cell");
     assert!(m.pixel_dir(64, 48, 56.0, 40.0).is_none(), "unused cell");
@@ -520,7 +522,10 @@ fn cube_layout_cells() {
 fn cube_edges_match_across_the_layouts() {
     let s = 32;
     for layout in CubeLayout::ALL {
-        if layout == CubeLayout::HorizontalStrip {
+        if matches!(
+            layout,
+            CubeLayout::HorizontalStrip | CubeLayout::VerticalStrip
+        ) {
             // Not a net: its neighbours +X|-X, +Y|-Y, +Z|-Z are opposite faces.
             continue;
         }

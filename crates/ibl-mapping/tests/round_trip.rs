@@ -37,6 +37,7 @@ fn intermediates() -> Vec<Mapping> {
         Mapping::Cube(CubeLayout::HorizontalCross),
         Mapping::Cube(CubeLayout::VerticalCross),
         Mapping::Cube(CubeLayout::HorizontalStrip),
+        Mapping::Cube(CubeLayout::VerticalStrip),
         Mapping::Fisheye { fov_deg: 360.0 },
         Mapping::DualFisheye { fov_deg: 200.0 },
     ]

@@ -24,6 +24,7 @@ fn targets() -> Vec<(Mapping, usize, usize)> {
         (Mapping::Cube(CubeLayout::HorizontalCross), 128, 96),
         (Mapping::Cube(CubeLayout::VerticalCross), 96, 128),
         (Mapping::Cube(CubeLayout::HorizontalStrip), 192, 32),
+        (Mapping::Cube(CubeLayout::VerticalStrip), 32, 192),
         (Mapping::Fisheye { fov_deg: 360.0 }, 96, 96),
         (Mapping::Fisheye { fov_deg: 180.0 }, 64, 64),
         (Mapping::Fisheye { fov_deg: 195.0 }, 64, 64),

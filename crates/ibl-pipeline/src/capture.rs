@@ -17,6 +17,7 @@ use ibl_io::WriteOptions;
 use serde::Serialize;
 
 use crate::error::{Context, PipelineError, Result};
+use crate::exposure_list::{TimeUnit, parse_times_file};
 
 /// How the camera's response is known.
 #[derive(Clone, Debug, PartialEq)]
@@ -50,8 +51,9 @@ pub enum ExposureTimes {
     Exif,
     /// Given, in seconds, one per image in order.
     Given(Vec<f64>),
-    /// A file of numbers or fractions separated by commas, spaces or lines.
-    File(PathBuf),
+    /// A file of numbers or fractions, or of `name value` lines ([`crate::exposure_list`]), in
+    /// the unit given (`None`: seconds, or what a two-column file's name says).
+    File(PathBuf, Option<TimeUnit>),
 }
 
 /// What to merge.
@@ -151,14 +153,14 @@ pub fn merge_bracket(job: &MergeJob) -> Result<MergeSummary> {
         csv.with_extension("png"),
     ];
     let mut inputs: Vec<&Path> = job.images.iter().map(PathBuf::as_path).collect();
-    if let ExposureTimes::File(t) = &job.times {
+    if let ExposureTimes::File(t, _) = &job.times {
         inputs.push(t);
     }
     if let Response::Given(c) = &job.response {
         inputs.push(c);
     }
     for out in &outputs {
-        ibl_io::ensure_output_is_not_input(out, &inputs)?;
+        crate::output_paths::check_output_path(out, &inputs)?;
     }
 
     let photos = job
@@ -299,10 +301,9 @@ fn exposure_times(
 ) -> Result<(Vec<f64>, &'static str)> {
     let (times, from) = match &job.times {
         ExposureTimes::Given(t) => (t.clone(), "--times"),
-        ExposureTimes::File(path) => {
+        ExposureTimes::File(path, unit) => {
             let text = ibl_io::read_text(path, MAX_TEXT_BYTES)?;
-            let t = ibl_io::photo::parse_exposure_times(&text)
-                .map_err(|e| PipelineError::parameter(format!("{}: {e}", path.display())))?;
+            let (t, _) = parse_times_file(path, &text, &job.images, *unit)?;
             (t, "--times-file")
         }
         ExposureTimes::Exif => {

@@ -87,11 +87,12 @@ pub fn unwrap_balls(job: &BallJob) -> Result<BallSummary> {
     }
     let inputs: Vec<&Path> = job.views.iter().map(|v| v.photo.as_path()).collect();
     for out in &outputs {
-        ibl_io::ensure_output_is_not_input(out, &inputs)?;
+        crate::output_paths::check_output_path(out, &inputs)?;
     }
     let mut views = Vec::new();
     let mut summary = Vec::new();
-    for (k, view) in job.views.iter().enumerate() {
+    let mut reliability_maps = Vec::new();
+    for view in &job.views {
         let path = view.photo.display().to_string();
         let photo = ibl_io::read_image(&view.photo)?.image;
         let (circle, found) = match view.circle {
@@ -105,6 +106,17 @@ pub fn unwrap_balls(job: &BallJob) -> Result<BallSummary> {
             .iter()
             .filter(|&&r| r > 0.5)
             .count();
+        if reliable == 0 {
+            // Issue 13: "0 % of the sphere reliable" used to exit 0 with an empty probe.
+            return Err(PipelineError::parameter(format!(
+                "{path}: no part of the sphere is reliable with the ball at ({:.1}, {:.1}) radius \
+                 {:.1} px{}: the circle does not fit a mirror ball; check it (--circle X,Y,R)",
+                circle.cx,
+                circle.cy,
+                circle.r,
+                if found { " (found automatically)" } else { "" }
+            )));
+        }
         summary.push(BallViewSummary {
             photo: path,
             circle,
@@ -112,9 +124,12 @@ pub fn unwrap_balls(job: &BallJob) -> Result<BallSummary> {
             yaw_deg: view.yaw_deg,
             reliable_fraction: reliable as f64 / unwrapped.reliability.len().max(1) as f64,
         });
-        let grey = unwrapped.reliability.map(|&r| Rgb::splat(r));
-        ibl_io::write_image(&outputs[2 + k], &grey, &WriteOptions::default())?;
+        reliability_maps.push(unwrapped.reliability.map(|&r| Rgb::splat(r)));
         views.push((unwrapped, view.yaw_deg));
+    }
+    // Nothing is written until every view has unwrapped.
+    for (k, grey) in reliability_maps.iter().enumerate() {
+        ibl_io::write_image(&outputs[2 + k], grey, &WriteOptions::default())?;
     }
     let probe = merge_views(&views).context("merging the views")?;
     write_with_preview(&job.output, &probe)?;
@@ -163,7 +178,7 @@ pub fn stitch_fisheyes(job: &FisheyeJob) -> Result<Stitched> {
     }
     let outputs = [job.output.clone(), job.output.with_extension("png")];
     for out in &outputs {
-        ibl_io::ensure_output_is_not_input(out, &inputs)?;
+        crate::output_paths::check_output_path(out, &inputs)?;
     }
     let front = ibl_io::read_image(&job.front)?.image;
     let back = match &job.back {

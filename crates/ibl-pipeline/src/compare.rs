@@ -132,7 +132,7 @@ pub fn compare(o: &CompareOptions, progress: &dyn Progress) -> Result<CompareSum
     inputs.extend(o.mask.as_deref());
     let out_format = match &o.error_image {
         Some(out) => {
-            ibl_io::ensure_output_is_not_input(out, &inputs)?;
+            crate::output_paths::check_output_path(out, &inputs)?;
             Some(ImageFormat::from_path(out).ok_or_else(|| {
                 PipelineError::parameter(format!(
                     "{}: an error image is written as .png, .jpg, .exr, .hdr or .pfm",

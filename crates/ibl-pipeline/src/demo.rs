@@ -98,6 +98,7 @@ pub fn list_probes(dir: &Path) -> Result<Vec<PathBuf>> {
 /// Runs the demo (see the module doc).
 pub fn demo(o: &DemoOptions, progress: &dyn Progress) -> Result<Demo> {
     let probes = list_probes(&o.probes)?;
+    crate::output_paths::check_output_folder(&o.out)?;
     ibl_io::create_dir_all(&o.out)?;
     let mappings = demo_mappings();
     // Per probe: the preview, each mapping, the irradiance maps.

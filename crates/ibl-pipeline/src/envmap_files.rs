@@ -33,7 +33,7 @@ impl EnvMapping {
         Mapping::parse(name, fov_deg).map(EnvMapping::Single).ok_or_else(|| {
             PipelineError::parameter(format!(
                 "unknown mapping `{name}` (expected latlong, angular, mirror-ball, cube-hcross, \
-                 cube-vcross, cube-strip, cube-faces, fisheye or dual-fisheye)"
+                 cube-vcross, cube-strip, cube-vstrip, cube-faces, fisheye or dual-fisheye)"
             ))
         })
     }
@@ -63,20 +63,23 @@ pub fn check_output(path: &Path, inputs: &[&Path]) -> Result<()> {
             path.display()
         )));
     }
-    ibl_io::ensure_output_is_not_input(path, inputs)?;
+    crate::output_paths::check_output_path(path, inputs)?;
     Ok(())
 }
 
 /// Tells the user, through `progress`, how many invalid values reading clamped, if any.
 pub fn note_clamped(env: &LoadedEnv, progress: &dyn Progress) {
-    let r = &env.report;
+    if let Some(first) = env.files.first() {
+        note_sanitized(first, &env.report, progress);
+    }
+}
+
+/// The same for one file read with `ibl_io::read_image`.
+pub fn note_sanitized(path: &Path, r: &SanitizeReport, progress: &dyn Progress) {
     if r.negative_values + r.nonfinite_values > 0 {
         progress.note(&format!(
             "note: {}: clamped {} negative and {} NaN/Inf values to 0",
-            env.files
-                .first()
-                .map(|p| p.display().to_string())
-                .unwrap_or_default(),
+            path.display(),
             r.negative_values,
             r.nonfinite_values
         ));
@@ -122,7 +125,18 @@ pub fn face_paths(pattern: &Path) -> Vec<PathBuf> {
         .collect()
 }
 
-/// Reads an environment map; the mapping is `mapping` or, when `None`, guessed from the shape.
+/// The error for an image whose shape names no mapping (issue 13: never taken for lat-long).
+pub fn undetectable(path: &Path, width: usize, height: usize) -> PipelineError {
+    PipelineError::parameter(format!(
+        "{}: cannot tell the mapping of a {width} x {height} image from its shape (known shapes: \
+         2:1 lat-long, 1:1 angular or mirror ball, 4:3 / 3:4 cube cross, 6:1 / 1:6 cube strip); \
+         name it with --mapping (or --from)",
+        path.display()
+    ))
+}
+
+/// Reads an environment map; the mapping is `mapping` or, when `None`, detected from the shape
+/// ([`Mapping::detect_from_shape`]; a shape that names no mapping is refused).
 pub fn load(path: &Path, mapping: Option<EnvMapping>) -> Result<LoadedEnv> {
     if mapping == Some(EnvMapping::CubeFaces) {
         return load_faces(path);
@@ -135,14 +149,15 @@ pub fn load(path: &Path, mapping: Option<EnvMapping>) -> Result<LoadedEnv> {
     } = ibl_io::read_image(path)?;
     let mapping = match mapping {
         Some(m) => m.in_memory(),
-        None => Mapping::guess_from_shape(image.width(), image.height()),
+        None => Mapping::detect_from_shape(image.width(), image.height())
+            .ok_or_else(|| undetectable(path, image.width(), image.height()))?,
     };
     mapping
         .check_shape(image.width(), image.height())
         .context(format!(
-            "{}: not a {} image",
+            "{}: not {} image",
             path.display(),
-            mapping.name()
+            ibl_mapping::with_article(&mapping.name())
         ))?;
     Ok(LoadedEnv {
         image,

@@ -26,10 +26,10 @@ use ibl_eval::{
 };
 use ibl_extract::{ExtractOptions, ModelSpec};
 use ibl_light::Method;
-use ibl_mapping::Mapping;
 
-use crate::envmap_files::{self, EnvMapping};
+use crate::envmap_files::EnvMapping;
 use crate::error::{PipelineError, Result};
+use crate::probe_input::load_probe;
 use crate::progress::Progress;
 
 /// Light counts swept by default: the paper's powers of two, 1 to 256.
@@ -57,6 +57,8 @@ pub struct EvalSettings {
     pub seed: u64,
     /// Light count of the sphere figures and overlays (one of `counts`).
     pub figure_n: usize,
+    /// Mapping of every probe (`None`: each detected from its shape).
+    pub mapping: Option<EnvMapping>,
 }
 
 impl EvalSettings {
@@ -103,6 +105,7 @@ impl EvalSettings {
             normals,
             seed,
             figure_n,
+            mapping: None,
         })
     }
 }
@@ -150,12 +153,15 @@ fn file_safe(name: &str) -> String {
 
 /// Loads every probe as a lat-long map; names are file stems made unique (and never `average`,
 /// the name of the averaged plot).
-fn load_probes(paths: &[PathBuf], progress: &dyn Progress) -> Result<Vec<Probe>> {
+fn load_probes(
+    paths: &[PathBuf],
+    mapping: Option<EnvMapping>,
+    progress: &dyn Progress,
+) -> Result<Vec<Probe>> {
     let mut taken: HashSet<String> = HashSet::from(["average".to_string()]);
     let mut probes = Vec::with_capacity(paths.len());
     for path in paths {
-        let env = envmap_files::load(path, Some(EnvMapping::Single(Mapping::LatLong)))?;
-        envmap_files::note_clamped(&env, progress);
+        let env = load_probe(path, mapping, progress)?.env;
         let stem = path
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
@@ -184,7 +190,7 @@ fn write_output(out: &Path, relative: &str, bytes: &[u8], inputs: &[&Path]) -> R
     if let Some(dir) = path.parent() {
         ibl_io::create_dir_all(dir)?;
     }
-    ibl_io::ensure_output_is_not_input(&path, inputs)?;
+    crate::output_paths::check_output_path(&path, inputs)?;
     ibl_io::write_atomically(&path, bytes)?;
     Ok(())
 }
@@ -241,7 +247,8 @@ pub fn evaluate(
     out: &Path,
     progress: &dyn Progress,
 ) -> Result<Report> {
-    let probes = load_probes(paths, progress)?;
+    crate::output_paths::check_output_folder(out)?;
+    let probes = load_probes(paths, settings.mapping, progress)?;
     ibl_io::create_dir_all(out)?;
     let inputs: Vec<&Path> = probes.iter().map(|p| p.path.as_path()).collect();
     // Refuse before the (long) sweep if any planned output is an input.

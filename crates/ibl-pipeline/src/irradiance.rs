@@ -19,6 +19,7 @@ use serde::Serialize;
 
 use crate::envmap_files::{self, EnvMapping};
 use crate::error::{Context, PipelineError, Result};
+use crate::probe_input::{LoadedProbe, ProbeDetection, load_probe};
 use crate::progress::{self, Progress};
 
 /// How to compute the irradiance.
@@ -47,8 +48,10 @@ impl IrradianceMethod {
 /// What to compute and where to write it.
 #[derive(Clone, Debug, PartialEq)]
 pub struct IrradianceOptions {
-    /// Lat-long probe.
+    /// The probe, in any mapping ([`crate::probe_input`]).
     pub probe: PathBuf,
+    /// Mapping of the probe (`None`: detected from its shape).
+    pub mapping: Option<EnvMapping>,
     /// How.
     pub method: IrradianceMethod,
     /// SH bands (`Sh` only).
@@ -101,6 +104,8 @@ pub struct IrradianceSummary {
     pub max_err_pct: Option<f64>,
     /// Files written.
     pub outputs: Vec<String>,
+    /// What the probe loader detected and did.
+    pub probe_input: ProbeDetection,
 }
 
 /// An irradiance evaluator for one probe and method.
@@ -155,7 +160,7 @@ fn check(o: &IrradianceOptions) -> Result<()> {
     }
     let inputs = [o.probe.as_path()];
     for out in o.csv.iter().chain(&o.output) {
-        ibl_io::ensure_output_is_not_input(out, &inputs)?;
+        crate::output_paths::check_output_path(out, &inputs)?;
     }
     if o.csv.is_some() && o.csv == o.output {
         return Err(PipelineError::parameter("--csv and -o name the same file"));
@@ -166,13 +171,16 @@ fn check(o: &IrradianceOptions) -> Result<()> {
 /// Computes the irradiance and writes the CSV and the map asked for.
 pub fn irradiance(o: &IrradianceOptions, progress: &dyn Progress) -> Result<IrradianceSummary> {
     check(o)?;
-    let env = envmap_files::load(&o.probe, Some(EnvMapping::Single(Mapping::LatLong)))?;
-    envmap_files::note_clamped(&env, progress);
+    let LoadedProbe { env, detection } = load_probe(&o.probe, o.mapping, progress)?;
     let label = format!("{} irradiance", o.method.name());
-    progress::task(progress, &label, || compute(o, &env.image))
+    progress::task(progress, &label, || compute(o, &env.image, detection))
 }
 
-fn compute(o: &IrradianceOptions, probe: &Image<Rgb>) -> Result<IrradianceSummary> {
+fn compute(
+    o: &IrradianceOptions,
+    probe: &Image<Rgb>,
+    detection: ProbeDetection,
+) -> Result<IrradianceSummary> {
     let start = Instant::now();
     let evaluator = match o.method {
         IrradianceMethod::Exact => Evaluator::Exact(probe),
@@ -237,6 +245,7 @@ fn compute(o: &IrradianceOptions, probe: &Image<Rgb>) -> Result<IrradianceSummar
         mean_err_pct: errors.as_ref().map(|e| e.mean_err_pct),
         max_err_pct: errors.as_ref().map(|e| e.max_err_pct),
         outputs,
+        probe_input: detection,
     })
 }
 

@@ -5,6 +5,7 @@
 //! Progress and notes go through the [`Progress`] the front end supplies; nothing here prints.
 //!
 //! - [`envmap_files`]: environment maps on disk, one file in any mapping or six cube faces;
+//!   [`probe_input`]: the one probe loader (mapping detected or given, converted to lat-long);
 //! - [`info`]: probe statistics; [`convert`]: mappings, formats, rotations, frame presets;
 //!   [`preview`]: tone-mapped pictures; [`irradiance`]: irradiance on normals and as maps;
 //! - [`lights`]: light sets in every format, hybrid lighting, overlays; [`sh`]: spherical
@@ -17,9 +18,12 @@
 //! - [`room_calibrate`], [`room_estimate`], [`room_lights`]: the reconstructed room of Grosch
 //!   2005 (marks to frame and scale, room and probe to reflectance and the report, the important
 //!   patches as an area-light file), on [`room_input`];
-//! - [`capture`]: brackets merged to HDR; [`capture_views`]: mirror balls and fisheye pairs;
+//! - [`capture`]: brackets merged to HDR ([`exposure_list`]: the time files it reads);
+//!   [`capture_views`]: mirror balls and fisheye pairs;
 //! - [`demo`]: the main job on the bundled probes and scenes ([`demo_probe`], [`demo_render`],
 //!   [`demo_page`], [`demo_paths`], [`demo_room`]).
+//!
+//! Every output path is checked before the work starts ([`output_paths`]).
 //!
 //! Errors are [`PipelineError`]s, split by cause; [`PipelineError::is_bad_input`] tells the
 //! caller's fault from ours.
@@ -37,12 +41,15 @@ pub mod demo_room;
 pub mod envmap_files;
 pub mod error;
 pub mod eval;
+pub mod exposure_list;
 pub mod info;
 pub mod irradiance;
 pub mod lighting_plan;
 pub mod lights;
+pub mod output_paths;
 pub mod prefilter;
 pub mod preview;
+pub mod probe_input;
 pub mod progress;
 pub mod render;
 pub mod room_calibrate;
@@ -54,4 +61,5 @@ pub mod sh;
 pub use envmap_files::EnvMapping;
 pub use error::{PipelineError, Result};
 pub use lighting_plan::LightingPlan;
+pub use probe_input::{LoadedProbe, ProbeDetection, load_probe};
 pub use progress::{Progress, Silent};

@@ -18,15 +18,18 @@ use ibl_io::light_file::{AmbientRecord, LightsFile};
 use ibl_light::{LightSet, MAX_MEDIAN_CUT_SPLITS, Method, ProbeRef};
 use ibl_mapping::Mapping;
 
-use crate::envmap_files::{self, EnvMapping};
+use crate::envmap_files::EnvMapping;
 use crate::error::{Context, PipelineError, Result};
+use crate::probe_input::{LoadedProbe, ProbeDetection, load_probe};
 use crate::progress::{self, Progress};
 
 /// What to extract and where to write it.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LightsOptions {
-    /// Lat-long probe.
+    /// The probe, in any mapping ([`crate::probe_input`]).
     pub probe: PathBuf,
+    /// Mapping of the probe (`None`: detected from its shape).
+    pub mapping: Option<EnvMapping>,
     /// Number of lights.
     pub count: usize,
     /// Extraction method.
@@ -56,6 +59,8 @@ pub struct LightsResult {
     pub probe_power: [f64; 3],
     /// The method's parameters as JSON numbers (as the light file holds them).
     pub parameters: serde_json::Value,
+    /// What the probe loader detected and did.
+    pub probe: ProbeDetection,
 }
 
 /// The options' outputs with their formats, checked before any work.
@@ -70,6 +75,11 @@ fn check(o: &LightsOptions) -> Result<Vec<(&Path, LightFormat)>> {
             "--lux-per-unit must be a finite positive number (got {})",
             o.lux_per_unit
         )));
+    }
+    if o.count == 0 {
+        return Err(PipelineError::parameter(
+            "-n 0: the number of lights must be N >= 1",
+        ));
     }
     if !o.method.accepts(o.count) {
         return Err(PipelineError::parameter(match o.method {
@@ -136,7 +146,7 @@ fn check(o: &LightsOptions) -> Result<Vec<(&Path, LightFormat)>> {
                 path.display()
             )));
         }
-        ibl_io::ensure_output_is_not_input(path, &[o.probe.as_path()])?;
+        crate::output_paths::check_output_path(path, &[o.probe.as_path()])?;
     }
     Ok(outputs)
 }
@@ -159,8 +169,7 @@ pub fn lights(o: &LightsOptions, progress: &dyn Progress) -> Result<LightsResult
         }
     }
 
-    let env = envmap_files::load(&o.probe, Some(EnvMapping::Single(Mapping::LatLong)))?;
-    envmap_files::note_clamped(&env, progress);
+    let LoadedProbe { env, detection } = load_probe(&o.probe, o.mapping, progress)?;
     let start = Instant::now();
     let label = format!("{method}: {} lights", o.count);
     let extracted = progress::task(progress, &label, || {
@@ -249,5 +258,6 @@ pub fn lights(o: &LightsOptions, progress: &dyn Progress) -> Result<LightsResult
         probe_power: ibl_mapping::power(&env.image, Mapping::LatLong),
         seconds,
         set,
+        probe: detection,
     })
 }

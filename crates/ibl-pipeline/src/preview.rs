@@ -33,7 +33,7 @@ pub fn preview(
             output.display()
         )));
     }
-    ibl_io::ensure_output_is_not_input(output, &[input])?;
+    crate::output_paths::check_output_path(output, &[input])?;
     let loaded = ibl_io::read_image(input)?;
     let stops = exposure_stops.unwrap_or_else(|| auto_exposure_stops(&loaded.image));
     let options = WriteOptions {

@@ -8,18 +8,18 @@ use std::path::{Path, PathBuf};
 use ibl_io::sh_file::{SH_CONVENTION, SH_FORMAT, format_sh};
 use ibl_io::{ShFile, ShFileFormat, ShQuantity};
 use ibl_light::ProbeRef;
-use ibl_mapping::Mapping;
 use ibl_sh::{MAX_BANDS, RadianceSh, Window, project_latlong};
 
-use crate::envmap_files::{self, EnvMapping};
+use crate::envmap_files::EnvMapping;
 use crate::error::{Context, PipelineError, Result};
+use crate::probe_input::load_probe;
 use crate::progress::Progress;
 
 /// Where the coefficients come from.
 #[derive(Clone, Debug, PartialEq)]
 pub enum ShSource {
-    /// A lat-long probe, projected.
-    Probe(PathBuf),
+    /// A probe in any mapping (`None`: detected from its shape), projected.
+    Probe(PathBuf, Option<EnvMapping>),
     /// An SH file in a tool's format.
     File(PathBuf, ShFileFormat),
 }
@@ -62,21 +62,29 @@ pub fn spherical_harmonics(
             "--bands must be between 1 and {MAX_BANDS}"
         )));
     }
-    if o.format != ShFileFormat::Json && (o.bands < 3 || o.quantity == ShQuantity::Irradiance) {
+    if o.format != ShFileFormat::Json && (o.bands != 3 || o.quantity == ShQuantity::Irradiance) {
+        // Issue 13: `--bands 5` used to write 3 bands silently.
         return Err(PipelineError::parameter(format!(
-            "--format {}: holds 3 bands of radiance (use --bands 3 or more, and no --irradiance)",
-            o.format.name()
+            "--format {} holds exactly 3 bands of radiance (9 coefficients); got --bands {}{} \
+             (use --format json for other band counts and for irradiance)",
+            o.format.name(),
+            o.bands,
+            if o.quantity == ShQuantity::Irradiance {
+                " and --irradiance"
+            } else {
+                ""
+            }
         )));
     }
     let input = match &o.source {
-        ShSource::Probe(p) | ShSource::File(p, _) => p,
+        ShSource::Probe(p, _) | ShSource::File(p, _) => p,
     };
     if let Some(out) = output {
-        ibl_io::ensure_output_is_not_input(out, &[input.as_path()])?;
+        crate::output_paths::check_output_path(out, &[input.as_path()])?;
     }
     let file = match &o.source {
         ShSource::File(path, from) => read_back(o, path, *from)?,
-        ShSource::Probe(path) => project(o, path, progress)?,
+        ShSource::Probe(path, mapping) => project(o, path, *mapping, progress)?,
     };
     let text = format_sh(o.format, &file)
         .map_err(|e| PipelineError::parameter(format!("--format {}: {e}", o.format.name())))?;
@@ -95,9 +103,13 @@ pub fn spherical_harmonics(
 }
 
 /// Projects the probe and applies the window (and the Lambert factors for irradiance).
-fn project(o: &ShOptions, path: &Path, progress: &dyn Progress) -> Result<ShFile> {
-    let env = envmap_files::load(path, Some(EnvMapping::Single(Mapping::LatLong)))?;
-    envmap_files::note_clamped(&env, progress);
+fn project(
+    o: &ShOptions,
+    path: &Path,
+    mapping: Option<EnvMapping>,
+    progress: &dyn Progress,
+) -> Result<ShFile> {
+    let env = load_probe(path, mapping, progress)?.env;
     let sh = project_latlong(&env.image, o.bands).context(path.display().to_string())?;
     let coefficients = match o.quantity {
         ShQuantity::Irradiance => sh.irradiance(o.window).coefficients().to_vec(),
