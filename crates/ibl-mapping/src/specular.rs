@@ -418,7 +418,7 @@ mod tests {
         // 256-pixel Khronos chain, level 1 (r = 1/7, 128-pixel faces): 4 pi alpha^2 / Omega.
         assert_eq!(samples_for_level(1.0 / 7.0, 256, texel(128)), 41);
         assert_eq!(samples_for_level(0.01, 256, texel(128)), MIN_SAMPLES);
-        assert_eq!(samples_for_level(0.9, 256, texel(8)), 256);
+        assert_eq!(samples_for_level(0.9, 256, texel(8)), 252); // 4 pi 0.81^2 / (4 pi / 384)
         assert_eq!(samples_for_level(0.9, 16, texel(8)), 16);
     }
 
