@@ -129,7 +129,7 @@ pub fn pixel_footprint(
 /// The closest hit of `ray` in `layer`, with the normal turned towards the ray's origin.
 pub fn cast(layer: &GeometryLayer, ray: &Ray) -> Option<SurfaceHit> {
     let hit = layer.bvh.closest_hit(ray, 0.0, f32::INFINITY)?;
-    let surface = layer.surface_point(&hit, ray.origin, ray.direction);
+    let surface = layer.surface_point(&hit, ray.direction);
     Some(SurfaceHit {
         position: surface.position,
         normal: surface.shading_normal,

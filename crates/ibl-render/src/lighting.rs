@@ -74,6 +74,9 @@ pub struct Ambient {
     bands: usize,
     /// `bands^2` RGB coefficients of the ambient radiance (probe units), world frame.
     coefficients: Vec<[f64; 3]>,
+    /// The same radiance as an SH expansion, for front ends that draw it (the viewer's
+    /// irradiance map).
+    sh: RadianceSh,
     /// Occlusion rays per shading point, at least 1.
     pub occlusion_rays: u32,
 }
@@ -88,8 +91,14 @@ impl Ambient {
         Ambient {
             bands,
             coefficients,
+            sh: radiance.truncated(bands),
             occlusion_rays: occlusion_rays.max(1),
         }
+    }
+
+    /// The ambient radiance as SH coefficients (world frame, probe units, `bands^2` terms).
+    pub fn radiance_sh(&self) -> &RadianceSh {
+        &self.sh
     }
 
     /// The ambient radiance arriving from the unit world direction `dir` (may be negative:

@@ -251,7 +251,8 @@ impl EnvironmentMaps {
 
 /// See [`EnvironmentMaps::glossy_level`].
 pub fn glossy_level(first_exponent: f32, levels: u32, exponent: f32) -> f32 {
-    if !(exponent > 0.0) {
+    // Not positive, or NaN: the roughest level.
+    if exponent.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
         return levels.saturating_sub(1) as f32;
     }
     (1.0 + 0.5 * (first_exponent / exponent).log2()).clamp(0.0, levels.saturating_sub(1) as f32)

@@ -61,7 +61,10 @@ pub fn scene_lighting(request: &SceneLightingRequest) -> Result<SceneLighting, S
     let set = set.ok_or_else(|| "the reference mode has no lights to draw".to_string())?;
     let (list, ambient) = match &lighting.illumination {
         Illumination::Lights(list) => (list, None),
-        Illumination::Hybrid(list, ambient) => (list, Some(&ambient.irradiance)),
+        Illumination::Hybrid(list, ambient) => (
+            list,
+            Some(ambient.radiance_sh().irradiance(ibl_sh::Window::None)),
+        ),
         Illumination::Environment => return Err("the reference mode has no lights".into()),
     };
     let plan = &request.plan;
@@ -70,12 +73,14 @@ pub fn scene_lighting(request: &SceneLightingRequest) -> Result<SceneLighting, S
         list.lights.len(),
         set.provenance.extraction.name()
     );
-    if let Some(sh) = ambient {
+    if let Some(sh) = &ambient {
         summary += &format!(" + SH{} ambient", sh.bands() * sh.bands());
     }
     Ok(SceneLighting {
         lights: list.lights.clone(),
-        ambient: ambient.map(|sh| irradiance_map(sh, IRRADIANCE_MAP_WIDTH)),
+        ambient: ambient
+            .as_ref()
+            .map(|sh| irradiance_map(sh, IRRADIANCE_MAP_WIDTH)),
         set,
         summary: format!("{summary}, {} shadows", plan.shadows.name()),
     })
@@ -142,7 +147,7 @@ pub fn probe_overlay(request: &ProbeOverlayRequest) -> Result<ProbeOverlay, Stri
     let irradiance = radiance_sh.irradiance(ibl_sh::Window::None);
     let mut irradiance_over_pi = irradiance_map(&irradiance, IRRADIANCE_MAP_WIDTH);
     for p in irradiance_over_pi.pixels_mut() {
-        *p = *p * std::f32::consts::FRAC_1_PI;
+        *p *= std::f32::consts::FRAC_1_PI;
     }
     let region_borders = region_borders(&set, probe.width(), probe.height());
     Ok(ProbeOverlay {

@@ -37,7 +37,18 @@ impl ProbeModel {
     pub fn open(path: &Path, mapping: Option<Mapping>) -> Result<ProbeModel, ViewerError> {
         let loaded = ibl_io::read_image(path)?;
         let (w, h) = (loaded.image.width(), loaded.image.height());
-        let mapping = mapping.unwrap_or_else(|| Mapping::guess_from_shape(w, h));
+        let mapping = match mapping.or_else(|| Mapping::detect_from_shape(w, h)) {
+            Some(mapping) => mapping,
+            None => {
+                return Err(ViewerError::Input {
+                    path: path.to_path_buf(),
+                    problem: format!(
+                        "a {w} x {h} image has no mapping its shape tells (2:1 lat-long, 1:1 \
+                         angular or mirror ball, 4:3 / 3:4 cross, 6:1 / 1:6 strip): give --mapping"
+                    ),
+                });
+            }
+        };
         mapping.check_shape(w, h).map_err(|e| ViewerError::Input {
             path: path.to_path_buf(),
             problem: e.to_string(),

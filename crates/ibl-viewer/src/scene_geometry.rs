@@ -71,10 +71,10 @@ fn layer_objects(layer: &GeometryLayer, material_base: u32) -> Vec<Vec<Vertex>> 
     let mut objects = vec![Vec::new(); layer.object_names.len()];
     for (tri, surface) in corners.iter().zip(&layer.surfaces) {
         let out: &mut Vec<Vertex> = &mut objects[surface.object as usize];
-        for k in 0..3 {
+        for (corner, normal) in tri.iter().zip(&surface.normals) {
             out.push(Vertex {
-                position: tri[k].to_array(),
-                normal: surface.normals[k].to_array(),
+                position: corner.to_array(),
+                normal: normal.to_array(),
                 material: material_base + surface.material,
             });
         }

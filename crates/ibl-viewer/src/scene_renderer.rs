@@ -94,8 +94,7 @@ fn photo_texture(
 ) -> Result<HdrTexture, ViewerError> {
     match &model.scene.background {
         Background::Photo(_) => {
-            let image = ibl_render::background::background_image(&model.scene, width, height)
-                .map_err(|e| ViewerError::Parameter(e.to_string()))?;
+            let image = ibl_render::background::background_image(&model.scene, width, height);
             Ok(upload_hdr(
                 &gpu.device,
                 &gpu.queue,

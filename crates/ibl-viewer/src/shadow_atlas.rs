@@ -418,6 +418,7 @@ mod tests {
             direction: Vec3::Y,
             irradiance: ibl_core::Rgb::ONE,
             cone: ibl_render::sampling::UniformCone::from_solid_angle(solid_angle),
+            frame: ibl_render::sampling::OrthonormalBasis::from_normal(Vec3::Y),
         };
         assert_eq!(cone_tangent(&light(0.0)), 0.0);
         // A cone of half-angle a has solid angle 2 pi (1 - cos a); a = 30 degrees.

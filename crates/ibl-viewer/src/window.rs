@@ -408,7 +408,7 @@ impl ViewerApp {
                     .targets()
                     .map(|t| self.content.display_rect(rect, t.size));
                 if let Some(shown) = shown {
-                    let input = ctx.input(|i| panels::PointerInput::of(i));
+                    let input = ctx.input(panels::PointerInput::of);
                     self.content.pointer(&response, shown, &input);
                 }
                 panels::central_messages(ui, self, rect);

@@ -49,6 +49,7 @@ fn compare(name: &str) {
         spp: 16,
         bounces: 1,
         seed: 1,
+        sampler: scene.render.sampler,
     };
     let cpu = render(scene, &lighting, &settings, &|_, _| {}).expect("cpu renders");
     let cpu_seconds = started.elapsed().as_secs_f64();
