@@ -5,10 +5,11 @@
 //! nothing. `IBL_PROGRESS_SECONDS` sets the interval (0: a line on every update).
 
 use std::io::IsTerminal;
-use std::sync::{Arc, Mutex};
-use std::time::{Duration, Instant};
+use std::sync::Mutex;
+use std::time::Duration;
 
 use ibl_pipeline::Progress;
+use ibl_pipeline::progress_lines::TimedLines;
 use indicatif::{ProgressBar, ProgressStyle};
 
 /// Default seconds between two progress lines when stderr is not a terminal.
@@ -18,62 +19,8 @@ const LINE_INTERVAL_S: f64 = 3.0;
 pub enum Bars {
     /// stderr is a terminal.
     Terminal(Mutex<Option<ProgressBar>>),
-    /// stderr is a file or a pipe; a ticker thread prints for tasks that report no steps.
-    Lines(Arc<Mutex<LineState>>),
-}
-
-/// The task being reported as lines.
-pub struct LineState {
-    label: String,
-    active: bool,
-    done: u64,
-    total: u64,
-    detail: Option<String>,
-    started: Instant,
-    last_line: Instant,
-    interval: Duration,
-    lines: usize,
-}
-
-impl LineState {
-    /// Prints the progress line if the interval has passed since the last one.
-    fn maybe_print(&mut self) {
-        let now = Instant::now();
-        if !self.active || now.duration_since(self.last_line) < self.interval {
-            return;
-        }
-        self.last_line = now;
-        self.lines += 1;
-        let elapsed = now.duration_since(self.started).as_secs_f64();
-        let what = self
-            .detail
-            .as_ref()
-            .map(|d| format!(" ({d})"))
-            .unwrap_or_default();
-        if self.total > 0 {
-            eprintln!(
-                "{}: {}/{}{what}, {elapsed:.1} s",
-                self.label, self.done, self.total
-            );
-        } else {
-            eprintln!("{}: running{what}, {elapsed:.1} s", self.label);
-        }
-    }
-}
-
-/// Prints for tasks that go quiet (a long extraction reports no steps) until the process ends.
-fn start_ticker(state: &Arc<Mutex<LineState>>, interval: Duration) {
-    let state = Arc::clone(state);
-    let nap = interval.clamp(Duration::from_millis(50), Duration::from_millis(500));
-    std::thread::spawn(move || {
-        loop {
-            std::thread::sleep(nap);
-            match state.lock() {
-                Ok(mut s) => s.maybe_print(),
-                Err(_) => return,
-            }
-        }
-    });
+    /// stderr is a file or a pipe.
+    Lines(TimedLines),
 }
 
 impl Default for Bars {
@@ -86,21 +33,9 @@ impl Default for Bars {
                 .and_then(|v| v.parse::<f64>().ok())
                 .filter(|v| v.is_finite() && *v >= 0.0)
                 .unwrap_or(LINE_INTERVAL_S);
-            let now = Instant::now();
-            let interval = Duration::from_secs_f64(seconds);
-            let state = Arc::new(Mutex::new(LineState {
-                label: String::new(),
-                active: false,
-                done: 0,
-                total: 0,
-                detail: None,
-                started: now,
-                last_line: now,
-                interval,
-                lines: 0,
-            }));
-            start_ticker(&state, interval);
-            Bars::Lines(state)
+            Bars::Lines(TimedLines::new(Duration::from_secs_f64(seconds), |line| {
+                eprintln!("{line}")
+            }))
         }
     }
 }
@@ -146,19 +81,7 @@ impl Progress for Bars {
                     old.finish_and_clear();
                 }
             }
-            Bars::Lines(state) => {
-                if let Ok(mut s) = state.lock() {
-                    let now = Instant::now();
-                    s.label = label.to_string();
-                    s.active = true;
-                    s.done = 0;
-                    s.total = total;
-                    s.detail = None;
-                    s.started = now;
-                    s.last_line = now;
-                    s.lines = 0;
-                }
-            }
+            Bars::Lines(lines) => lines.begin(label, total),
         }
     }
 
@@ -171,16 +94,7 @@ impl Progress for Bars {
                     bar.set_message(detail.to_string());
                 }
             }),
-            Bars::Lines(state) => {
-                if let Ok(mut s) = state.lock() {
-                    s.done = done;
-                    s.total = total;
-                    if let Some(d) = detail {
-                        s.detail = Some(d.to_string());
-                    }
-                    s.maybe_print();
-                }
-            }
+            Bars::Lines(lines) => lines.update(done, total, detail),
         }
     }
 
@@ -193,16 +107,7 @@ impl Progress for Bars {
                     bar.finish_and_clear();
                 }
             }
-            Bars::Lines(state) => {
-                // A task that printed progress says when it is over.
-                if let Ok(mut s) = state.lock() {
-                    s.active = false;
-                    if s.lines > 0 {
-                        let elapsed = s.started.elapsed().as_secs_f64();
-                        eprintln!("{}: done, {elapsed:.1} s", s.label);
-                    }
-                }
-            }
+            Bars::Lines(lines) => lines.end(),
         }
     }
 

@@ -3,29 +3,8 @@
 
 use std::path::PathBuf;
 
-use clap::{Args, ValueEnum};
-use ibl_core::tonemap::ToneCurve;
-
-/// A tone curve as named on the command line.
-#[derive(Clone, Copy, Debug, ValueEnum)]
-pub enum CurveArg {
-    /// Clip at 1.
-    Clamp,
-    /// `x / (1 + x)`.
-    Reinhard,
-    /// ACES filmic (Narkowicz fit).
-    Aces,
-}
-
-impl From<CurveArg> for ToneCurve {
-    fn from(c: CurveArg) -> ToneCurve {
-        match c {
-            CurveArg::Clamp => ToneCurve::Clamp,
-            CurveArg::Reinhard => ToneCurve::Reinhard,
-            CurveArg::Aces => ToneCurve::AcesFilmic,
-        }
-    }
-}
+use clap::Args;
+pub use ibl_viewer::command_line::CurveArg;
 
 /// Arguments of `ibl preview`.
 #[derive(Args)]

@@ -51,6 +51,7 @@ pub mod prefilter;
 pub mod preview;
 pub mod probe_input;
 pub mod progress;
+pub mod progress_lines;
 pub mod render;
 pub mod room_calibrate;
 pub mod room_estimate;

@@ -564,7 +564,7 @@ impl PolygonDescription {
         for (k, v) in self.vertices.iter().enumerate() {
             coordinate3(&format!("{field}.vertices[{k}]"), *v)?;
         }
-        crate::geometry::polygon_frame(&self.vertices)
+        crate::polygon::polygon_frame(&self.vertices)
             .map(|_| ())
             .map_err(|problem| RoomError::invalid(format!("{field}.vertices"), problem))
     }

@@ -37,6 +37,7 @@ pub mod observation;
 pub mod patches;
 pub mod picture;
 pub mod placement;
+mod polygon;
 pub mod radiosity;
 pub mod reflectance;
 pub mod report;

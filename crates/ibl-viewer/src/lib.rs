@@ -31,6 +31,7 @@
 //! replaces it by a 3-D texture read at the shading point), and the worker recomputes either off
 //! the UI thread.
 
+pub mod command_line;
 pub mod display_pass;
 pub mod environment_maps;
 mod error;

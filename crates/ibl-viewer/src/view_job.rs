@@ -316,3 +316,37 @@ fn summary(
         outputs,
     }
 }
+
+impl ViewSummary {
+    /// The summary as one line of text (what `ibl view --headless` prints).
+    pub fn line(&self) -> String {
+        let s = self;
+        let t = &s.statistics;
+        let gpu = t
+            .gpu_ms_median
+            .map_or(String::new(), |g| format!(", GPU {g:.1} ms"));
+        let lights = if s.lights > 0 && s.shadow_map_texels > 0 {
+            format!(", {}, shadow maps {}^2", s.lighting, s.shadow_map_texels)
+        } else {
+            String::new()
+        };
+        let wrote = if s.outputs.is_empty() {
+            String::new()
+        } else {
+            format!("; wrote {}", s.outputs.join(", "))
+        };
+        format!(
+            "{}: {} frames of {} x {} on {}{lights}: {:.1} fps median ({:.1} ms), {:.1} fps at p95 ({:.1} ms); CPU {:.1} ms{gpu}{wrote}",
+            s.input,
+            s.frames,
+            s.width,
+            s.height,
+            s.adapter.line(),
+            t.fps_median,
+            t.frame_ms_median,
+            t.fps_p95,
+            t.frame_ms_p95,
+            t.cpu_ms_median,
+        )
+    }
+}

@@ -1,0 +1,244 @@
+//! The viewer's command line (`ibl view`): its arguments, parsed by clap, and the one call that
+//! opens the window or runs the headless job. It lives in the viewer, a front end, so the `ibl`
+//! binary only forwards the arguments and prints the summary.
+
+use std::path::PathBuf;
+
+use clap::{Args, ValueEnum};
+use ibl_core::tonemap::ToneCurve;
+use ibl_pipeline::Progress;
+
+use crate::headless::{self, HeadlessOptions, Motion};
+use crate::probe_model::Overlays;
+use crate::probe_pass::{ProbeLayer, ProbeProjection};
+use crate::scene_renderer::GlossySource;
+use crate::view_job::{ProbeViewOptions, ViewJob, ViewSummary};
+use crate::window::{self, WindowOptions};
+use crate::{Mapping, ViewerError};
+
+/// The tone curves on the command line (`ibl view`, `ibl preview`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum CurveArg {
+    /// Clip at 1.
+    Clamp,
+    /// `x / (1 + x)`.
+    Reinhard,
+    /// ACES filmic (Narkowicz fit).
+    Aces,
+}
+
+impl From<CurveArg> for ToneCurve {
+    fn from(c: CurveArg) -> ToneCurve {
+        match c {
+            CurveArg::Clamp => ToneCurve::Clamp,
+            CurveArg::Reinhard => ToneCurve::Reinhard,
+            CurveArg::Aces => ToneCurve::AcesFilmic,
+        }
+    }
+}
+
+/// Glossy reflections on the command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum GlossyArg {
+    /// The glossy lobe lit by the shadowed lights (as `ibl render`).
+    Lights,
+    /// The glossy lobe reflecting the prefiltered probe (unshadowed).
+    Environment,
+}
+
+/// What the probe viewer shows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum LayerArg {
+    /// The probe's radiance.
+    Radiance,
+    /// Its SH irradiance divided by pi (a white diffuse surface).
+    Irradiance,
+}
+
+/// Arguments of `ibl view`.
+#[derive(Args)]
+#[command(after_help = "\
+Examples:
+  ibl view assets/probes/sky.exr                         look around a probe (drag, wheel, keys 1-6)
+  ibl view assets/scenes/bunny-sky.toml                  the bunny with 16 shadowed lights
+  ibl view assets/scenes/bunny-sky.toml --headless --size 640x480 -o frame.png --json
+  ibl view assets/scenes/bunny-sky.toml --headless --bench --frames 120
+  ibl view probe.exr --headless --flat --method lightgen -n 32 -o lights.png
+  ibl view scene.toml --screenshot window.png           open the window, save it with its UI, quit
+
+In the window: left-drag turns the camera (or moves the object under the cursor), Shift-drag
+turns the object, Ctrl-drag scales it, right-drag pans, the wheel zooms; F12 saves the frame as
+EXR and PNG, Ctrl+S saves the scene, F11 toggles full screen; drop a probe or scene file onto the
+window to open it. -o FRAME writes FRAME and FRAME's .exr (or .png) twin.")]
+pub struct ViewArgs {
+    /// A probe (any format and mapping ibl reads) or a scene file (.toml, docs/SCENES.md).
+    pub input: PathBuf,
+    /// Render offscreen (no window) and write the last frame.
+    #[arg(long)]
+    pub headless: bool,
+    /// Frame size, WIDTHxHEIGHT pixels (headless; the window starts at this size).
+    #[arg(long, value_name = "WxH", default_value = "640x480", value_parser = frame_size)]
+    pub size: (u32, u32),
+    /// Frames to render (headless; default 1, or 120 with --bench).
+    #[arg(long, value_name = "K")]
+    pub frames: Option<u32>,
+    /// Output frame (.png or .exr; the other is written beside it). Headless only.
+    #[arg(short = 'o', long = "output", value_name = "FILE")]
+    pub output: Option<PathBuf>,
+    /// Orbit the camera and move the first object for K frames; report fps (median, p95).
+    #[arg(long)]
+    pub bench: bool,
+    /// Print a JSON summary (per-frame CPU and GPU times, statistics) on stdout.
+    #[arg(long)]
+    pub json: bool,
+    /// Save a screenshot of the window with its UI to FILE once it has drawn, then quit.
+    #[arg(long, value_name = "FILE", conflicts_with = "headless")]
+    pub screenshot: Option<PathBuf>,
+    /// Mapping of a probe file (default: guessed from its shape).
+    #[arg(long, value_name = "MAPPING", value_parser = mapping)]
+    pub mapping: Option<Mapping>,
+    /// Show the probe flat (lat-long) instead of looking around from its centre.
+    #[arg(long)]
+    pub flat: bool,
+    /// What the probe viewer shows.
+    #[arg(long, value_enum, default_value = "radiance")]
+    pub layer: LayerArg,
+    /// Laplacian sharpening of the probe, 0 to 2.
+    #[arg(long, default_value_t = 0.0)]
+    pub sharpen: f32,
+    /// Exposure in stops (default: automatic, as `ibl preview` and `ibl render`).
+    #[arg(long, value_name = "STOPS", allow_hyphen_values = true)]
+    pub exposure: Option<f32>,
+    /// Tone curve.
+    #[arg(long, value_enum, default_value = "reinhard")]
+    pub tonemap: CurveArg,
+    /// Light method of the probe overlay or the scene (default: the scene's, or median-cut).
+    #[arg(long, value_name = "METHOD")]
+    pub method: Option<String>,
+    /// Number of lights (default: the scene's, or 16).
+    #[arg(short = 'n', long = "n", value_name = "N")]
+    pub n: Option<u32>,
+    /// SH bands of the probe's irradiance layer or the scene's hybrid ambient.
+    #[arg(long, value_name = "B")]
+    pub bands: Option<u32>,
+    /// Overlays on a probe (comma-separated: lights, regions, dominant; or none).
+    #[arg(long, value_name = "LIST", default_value = "lights,dominant", value_parser = overlays)]
+    pub overlay: Overlays,
+    /// Shadow map side per light, texels (shrunk when the atlas would exceed 4096^2).
+    #[arg(long, value_name = "TEXELS", default_value_t = headless::DEFAULT_SHADOW_TILE,
+          value_parser = clap::value_parser!(u32).range(64..=8192))]
+    pub shadow_size: u32,
+    /// Glossy reflections.
+    #[arg(long, value_enum, default_value = "lights")]
+    pub glossy: GlossyArg,
+    /// Background rays per pixel axis (4, as `ibl render`, antialiases the magnified probe).
+    #[arg(long, value_name = "N", default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=8))]
+    pub background_rays: u32,
+}
+
+/// `WxH`, each side 1 to the viewer's limit.
+fn frame_size(text: &str) -> Result<(u32, u32), String> {
+    let max = crate::frame_targets::MAX_OUTPUT_SIDE;
+    let bad = || format!("`{text}`: expected WIDTHxHEIGHT, each side 1 to {max}, e.g. 640x480");
+    let (w, h) = text.split_once(['x', 'X']).ok_or_else(bad)?;
+    let side = |s: &str| {
+        s.trim()
+            .parse::<u32>()
+            .ok()
+            .filter(|v| (1..=max).contains(v))
+    };
+    Ok((side(w).ok_or_else(bad)?, side(h).ok_or_else(bad)?))
+}
+
+/// A mapping by name (`ibl convert`'s names but six face files; fisheyes at 180 degrees).
+fn mapping(name: &str) -> Result<Mapping, String> {
+    match ibl_pipeline::EnvMapping::parse(name, 180.0).map_err(|e| e.to_string())? {
+        ibl_pipeline::EnvMapping::Single(m) => Ok(m),
+        ibl_pipeline::EnvMapping::CubeFaces => {
+            Err("the viewer reads one image, not six faces".into())
+        }
+    }
+}
+
+/// `lights,regions,dominant` or `none`.
+fn overlays(text: &str) -> Result<Overlays, String> {
+    let mut o = Overlays {
+        lights: false,
+        regions: false,
+        dominant: false,
+    };
+    for item in text.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+        match item {
+            "lights" => o.lights = true,
+            "regions" => o.regions = true,
+            "dominant" => o.dominant = true,
+            "none" => {}
+            other => {
+                return Err(format!(
+                    "unknown overlay `{other}` (lights, regions, dominant, none)"
+                ));
+            }
+        }
+    }
+    Ok(o)
+}
+
+/// Runs `ibl view`: the window until it is closed (`None`), or the headless job and its
+/// summary.
+pub fn run(args: &ViewArgs, progress: &dyn Progress) -> Result<Option<ViewSummary>, ViewerError> {
+    if !args.headless {
+        if args.output.is_some() || args.bench || args.frames.is_some() {
+            return Err(ViewerError::Parameter(
+                "-o, --frames and --bench need --headless".into(),
+            ));
+        }
+        window::run(WindowOptions {
+            input: Some(args.input.clone()),
+            mapping: args.mapping,
+            size: args.size,
+            screenshot: args.screenshot.clone(),
+            shadow_tile: args.shadow_size,
+        })?;
+        return Ok(None);
+    }
+    let job = ViewJob {
+        input: args.input.clone(),
+        mapping: args.mapping,
+        output: args.output.clone(),
+        frames: HeadlessOptions {
+            size: args.size,
+            frames: args.frames.unwrap_or(if args.bench { 120 } else { 1 }),
+            motion: if args.bench {
+                Motion::Orbit
+            } else {
+                Motion::Still
+            },
+            shadow_tile: args.shadow_size,
+            glossy: match args.glossy {
+                GlossyArg::Lights => GlossySource::Lights,
+                GlossyArg::Environment => GlossySource::Environment,
+            },
+            background_rays: args.background_rays,
+            display: None,
+        },
+        exposure_stops: args.exposure,
+        curve: ToneCurve::from(args.tonemap),
+        method: args.method.clone(),
+        lights: args.n,
+        bands: args.bands,
+        probe: ProbeViewOptions {
+            projection: if args.flat {
+                ProbeProjection::LatLong
+            } else {
+                ProbeProjection::LookAround
+            },
+            layer: match args.layer {
+                LayerArg::Radiance => ProbeLayer::Radiance,
+                LayerArg::Irradiance => ProbeLayer::ShIrradiance,
+            },
+            sharpen: args.sharpen,
+            overlays: args.overlay,
+        },
+    };
+    job.run(progress).map(Some)
+}
