@@ -10,6 +10,12 @@ use ibl_core::{Image, Rgb};
 
 use crate::error::DecodeError;
 
+/// The KTX 2.0 file identifier, the first 12 bytes of every `.ktx2` file (KTX 2.0
+/// specification, section 3.1).
+pub const KTX2_IDENTIFIER: [u8; 12] = [
+    0xAB, 0x4B, 0x54, 0x58, 0x20, 0x32, 0x30, 0xBB, 0x0D, 0x0A, 0x1A, 0x0A,
+];
+
 /// An image file format.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum ImageFormat {
@@ -97,7 +103,7 @@ impl ImageFormat {
             Some(ImageFormat::Png)
         } else if bytes.starts_with(&[0xff, 0xd8, 0xff]) {
             Some(ImageFormat::Jpeg)
-        } else if bytes.starts_with(&crate::ktx2::IDENTIFIER) {
+        } else if bytes.starts_with(&KTX2_IDENTIFIER) {
             Some(ImageFormat::Ktx2)
         } else if bytes.starts_with(b"DDS ") {
             Some(ImageFormat::Dds)

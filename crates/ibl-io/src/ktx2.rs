@@ -23,10 +23,8 @@ use crate::error::DecodeError;
 use crate::format::Limits;
 use crate::texture::{DecodedTexture, TexelFormat, Texture, TextureKind, TextureLevel};
 
-/// The KTX 2.0 file identifier.
-pub const IDENTIFIER: [u8; 12] = [
-    0xAB, 0x4B, 0x54, 0x58, 0x20, 0x32, 0x30, 0xBB, 0x0D, 0x0A, 0x1A, 0x0A,
-];
+/// The KTX 2.0 file identifier (defined beside the format detection, which needs it too).
+pub use crate::format::KTX2_IDENTIFIER as IDENTIFIER;
 
 /// Header, index and level-index sizes (bytes).
 const HEADER_BYTES: usize = 12 + 9 * 4 + 4 * 4 + 2 * 8;
