@@ -12,13 +12,12 @@
 //! refuses unknown fields, checks every value and reference, and names the field at fault
 //! (`views[1].lines[3].to`). It never panics (fuzzed: `fuzz/fuzz_targets/room_marks.rs`).
 
-use std::collections::BTreeSet;
+use std::collections::{BTreeMap, BTreeSet};
 
 use serde::{Deserialize, Serialize};
 
 use crate::RoomError;
-use crate::description::GroupDescription;
-use crate::placement::ShapeMark;
+use crate::description::{BoxFace, GroupDescription};
 use crate::view::{MAX_VIEW_SIDE, PerspectiveView};
 
 /// The format tag of version 1.
@@ -333,7 +332,7 @@ impl MarksFile {
                 }
             }
         }
-        crate::placement::validate_shapes(self, &point_names)
+        validate_shapes(self, &point_names)
     }
 
     /// The named point's view and pixel position.
@@ -345,4 +344,304 @@ impl MarksFile {
                 .map(|p| (&v.camera, p.at))
         })
     }
+}
+
+/// A shape placed by constraints (the marks file's `shapes`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum ShapeMark {
+    /// The room's shell.
+    Room {
+        /// Name (default `room`).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        name: Option<String>,
+        /// Points where walls meet the floor (at least two, spanning both horizontal axes).
+        floor_corners: Vec<String>,
+        /// Ceiling height, metres ...
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        ceiling_m: Option<f64>,
+        /// ... or a point on the ceiling above a floor corner ...
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        ceiling_point: Option<String>,
+        /// ... namely this one.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        ceiling_above: Option<String>,
+        /// Group of the walls.
+        wall_group: String,
+        /// Group of particular walls (`"-z" = "window_wall"`).
+        #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+        wall_groups: BTreeMap<BoxFace, String>,
+        /// Group of the floor.
+        floor_group: String,
+        /// Group of the ceiling.
+        ceiling_group: String,
+    },
+    /// A window or door in a wall of the shell.
+    Opening {
+        /// Name for messages.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        name: Option<String>,
+        /// The wall (a vertical face of the shell: `+x`, `-x`, `+z`, `-z`).
+        wall: BoxFace,
+        /// Two opposite corners marked on the wall.
+        corners: [String; 2],
+        /// The group filling it.
+        group: String,
+        /// Extend it down to the floor (a door).
+        #[serde(default)]
+        to_floor: bool,
+    },
+    /// Furniture standing on the floor.
+    Box {
+        /// Name (unique; `mirror` refers to it).
+        name: String,
+        /// Group of every face.
+        group: String,
+        /// Groups of particular faces.
+        #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+        face_groups: BTreeMap<BoxFace, String>,
+        /// Marked floor points at its base (at least one; the extent on each horizontal axis
+        /// must be at least 1 cm after `against`).
+        footprint: Vec<String>,
+        /// Walls of the shell it stands against.
+        #[serde(default, skip_serializing_if = "Vec::is_empty")]
+        against: Vec<BoxFace>,
+        /// Height of its top, metres ...
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        top_m: Option<f64>,
+        /// ... or a marked point of its top above a footprint point ...
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        top_point: Option<String>,
+        /// ... namely this one ...
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        top_above: Option<String>,
+        /// ... or up to the ceiling.
+        #[serde(default)]
+        to_ceiling: bool,
+    },
+    /// The mirror image of an earlier box.
+    Mirror {
+        /// Name (unique).
+        name: String,
+        /// The box mirrored.
+        of: String,
+        /// The axis normal to the mirror plane (`x` or `z`).
+        axis: Axis,
+        /// A marked floor point the plane passes through ...
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        through: Option<String>,
+        /// ... or the plane's coordinate, metres.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        at_m: Option<f64>,
+    },
+}
+
+/// Checks the shapes' references (points, groups, boxes, walls) before anything is solved.
+pub(crate) fn validate_shapes(marks: &MarksFile, points: &BTreeSet<&str>) -> Result<(), RoomError> {
+    let groups: BTreeSet<&str> = marks.groups.iter().map(|g| g.name.as_str()).collect();
+    let point = |f: String, name: &str| -> Result<(), RoomError> {
+        if points.contains(name) {
+            Ok(())
+        } else {
+            Err(RoomError::invalid(f, format!("no point is named `{name}`")))
+        }
+    };
+    let group = |f: String, name: &str| -> Result<(), RoomError> {
+        if groups.contains(name) {
+            Ok(())
+        } else {
+            Err(RoomError::invalid(f, format!("no group is named `{name}`")))
+        }
+    };
+    let mut boxes = BTreeSet::new();
+    let mut rooms = 0;
+    for (k, shape) in marks.shapes.iter().enumerate() {
+        let f = format!("shapes[{k}]");
+        match shape {
+            ShapeMark::Room {
+                floor_corners,
+                ceiling_m,
+                ceiling_point,
+                ceiling_above,
+                wall_group,
+                wall_groups,
+                floor_group,
+                ceiling_group,
+                ..
+            } => {
+                rooms += 1;
+                if k != 0 {
+                    return Err(RoomError::invalid(
+                        f,
+                        "the room must be the first shape (the others refer to its walls)",
+                    ));
+                }
+                if floor_corners.len() < 2 {
+                    return Err(RoomError::invalid(
+                        format!("{f}.floor_corners"),
+                        "needs at least two points",
+                    ));
+                }
+                for (i, c) in floor_corners.iter().enumerate() {
+                    point(format!("{f}.floor_corners[{i}]"), c)?;
+                }
+                match (ceiling_m, ceiling_point, ceiling_above) {
+                    (Some(h), None, None) => {
+                        if !(h.is_finite() && *h > 0.0 && *h < 1e3) {
+                            return Err(RoomError::invalid(
+                                format!("{f}.ceiling_m"),
+                                format!("{h} is not a height in (0, 1000) m"),
+                            ));
+                        }
+                    }
+                    (None, Some(p), Some(a)) => {
+                        point(format!("{f}.ceiling_point"), p)?;
+                        point(format!("{f}.ceiling_above"), a)?;
+                    }
+                    _ => {
+                        return Err(RoomError::invalid(
+                            f,
+                            "give ceiling_m, or ceiling_point with ceiling_above",
+                        ));
+                    }
+                }
+                group(format!("{f}.wall_group"), wall_group)?;
+                group(format!("{f}.floor_group"), floor_group)?;
+                group(format!("{f}.ceiling_group"), ceiling_group)?;
+                for (face, g) in wall_groups {
+                    if face.axis() == 1 {
+                        return Err(RoomError::invalid(
+                            format!("{f}.wall_groups.{}", face.name()),
+                            "is not a wall",
+                        ));
+                    }
+                    group(format!("{f}.wall_groups.{}", face.name()), g)?;
+                }
+            }
+            ShapeMark::Opening {
+                wall,
+                corners,
+                group: g,
+                ..
+            } => {
+                if wall.axis() == 1 {
+                    return Err(RoomError::invalid(
+                        format!("{f}.wall"),
+                        format!("{} is not a wall", wall.name()),
+                    ));
+                }
+                point(format!("{f}.corners[0]"), &corners[0])?;
+                point(format!("{f}.corners[1]"), &corners[1])?;
+                group(format!("{f}.group"), g)?;
+            }
+            ShapeMark::Box {
+                name,
+                group: g,
+                face_groups,
+                footprint,
+                against,
+                top_m,
+                top_point,
+                top_above,
+                to_ceiling,
+            } => {
+                if !boxes.insert(name.as_str()) {
+                    return Err(RoomError::invalid(
+                        format!("{f}.name"),
+                        format!("box `{name}` is defined twice"),
+                    ));
+                }
+                group(format!("{f}.group"), g)?;
+                for (face, fg) in face_groups {
+                    group(format!("{f}.face_groups.{}", face.name()), fg)?;
+                }
+                if footprint.is_empty() {
+                    return Err(RoomError::invalid(
+                        format!("{f}.footprint"),
+                        "needs at least one point",
+                    ));
+                }
+                for (i, p) in footprint.iter().enumerate() {
+                    point(format!("{f}.footprint[{i}]"), p)?;
+                }
+                for (i, wall) in against.iter().enumerate() {
+                    if wall.axis() == 1 {
+                        return Err(RoomError::invalid(
+                            format!("{f}.against[{i}]"),
+                            format!("{} is not a wall", wall.name()),
+                        ));
+                    }
+                }
+                match (top_m, top_point, top_above, to_ceiling) {
+                    (Some(h), None, None, false) => {
+                        if !(h.is_finite() && *h > 0.0 && *h < 1e3) {
+                            return Err(RoomError::invalid(
+                                format!("{f}.top_m"),
+                                format!("{h} is not a height in (0, 1000) m"),
+                            ));
+                        }
+                    }
+                    (None, Some(p), Some(a), false) => {
+                        point(format!("{f}.top_point"), p)?;
+                        if !footprint.contains(a) {
+                            return Err(RoomError::invalid(
+                                format!("{f}.top_above"),
+                                format!("`{a}` is not one of the footprint's points"),
+                            ));
+                        }
+                    }
+                    (None, None, None, true) => {}
+                    _ => {
+                        return Err(RoomError::invalid(
+                            f,
+                            "give top_m, top_point with top_above, or to_ceiling",
+                        ));
+                    }
+                }
+            }
+            ShapeMark::Mirror {
+                name,
+                of,
+                axis,
+                through,
+                at_m,
+            } => {
+                if !boxes.contains(of.as_str()) {
+                    return Err(RoomError::invalid(
+                        format!("{f}.of"),
+                        format!("no earlier box is named `{of}`"),
+                    ));
+                }
+                if *axis == Axis::Y {
+                    return Err(RoomError::invalid(
+                        format!("{f}.axis"),
+                        "a mirror plane is vertical: x or z",
+                    ));
+                }
+                match (through, at_m) {
+                    (Some(p), None) => point(format!("{f}.through"), p)?,
+                    (None, Some(c)) if c.is_finite() && c.abs() < 1e4 => {}
+                    _ => {
+                        return Err(RoomError::invalid(
+                            f,
+                            "give either through (a floor point) or at_m",
+                        ));
+                    }
+                }
+                if !boxes.insert(name.as_str()) {
+                    return Err(RoomError::invalid(
+                        format!("{f}.name"),
+                        format!("box `{name}` is defined twice"),
+                    ));
+                }
+            }
+        }
+    }
+    if !marks.shapes.is_empty() && rooms != 1 {
+        return Err(RoomError::invalid(
+            "shapes",
+            "the shapes need exactly one `room` (the first)",
+        ));
+    }
+    Ok(())
 }
