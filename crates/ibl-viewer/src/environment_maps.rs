@@ -85,7 +85,7 @@ impl EnvironmentMaps {
             label: Some("environment_maps.wgsl"),
             source: wgpu::ShaderSource::Wgsl(include_str!("environment_maps.wgsl").into()),
         });
-        let sampler = device.create_sampler(&crate::scene_pass::probe_sampler_descriptor());
+        let sampler = device.create_sampler(&crate::textures::probe_sampler_descriptor());
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("prefilter"),
             entries: &[

@@ -189,7 +189,7 @@ impl ProbePass {
             pipeline,
             layout,
             uniform,
-            sampler: device.create_sampler(&crate::scene_pass::probe_sampler_descriptor()),
+            sampler: device.create_sampler(&crate::textures::probe_sampler_descriptor()),
         }
     }
 

@@ -10,21 +10,6 @@ use crate::scene_geometry::{VERTEX_ATTRIBUTES, Vertex};
 use crate::shadow_atlas::ShadowAtlases;
 use crate::textures::HdrTexture;
 
-/// The probe's sampler: bilinear and trilinear between mips, wrapping in longitude, clamped at
-/// the poles.
-pub fn probe_sampler_descriptor() -> wgpu::SamplerDescriptor<'static> {
-    wgpu::SamplerDescriptor {
-        label: Some("probe"),
-        address_mode_u: wgpu::AddressMode::Repeat,
-        address_mode_v: wgpu::AddressMode::ClampToEdge,
-        address_mode_w: wgpu::AddressMode::ClampToEdge,
-        mag_filter: wgpu::FilterMode::Linear,
-        min_filter: wgpu::FilterMode::Linear,
-        mipmap_filter: wgpu::MipmapFilterMode::Linear,
-        ..Default::default()
-    }
-}
-
 /// Pipelines and samplers of the scene pass.
 #[derive(Debug)]
 pub struct ScenePass {
@@ -192,7 +177,7 @@ impl ScenePass {
             geometry,
             sky,
             layout,
-            probe_sampler: device.create_sampler(&probe_sampler_descriptor()),
+            probe_sampler: device.create_sampler(&crate::textures::probe_sampler_descriptor()),
             shadow_sampler: device.create_sampler(&wgpu::SamplerDescriptor {
                 label: Some("shadow comparison"),
                 mag_filter: wgpu::FilterMode::Linear,

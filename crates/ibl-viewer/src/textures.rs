@@ -124,6 +124,21 @@ pub fn padded_bytes_per_row(width: u32, bytes_per_texel: u32) -> u32 {
     unpadded.div_ceil(align) * align
 }
 
+/// The probe's sampler: bilinear and trilinear between mips, wrapping in longitude, clamped at
+/// the poles.
+pub fn probe_sampler_descriptor() -> wgpu::SamplerDescriptor<'static> {
+    wgpu::SamplerDescriptor {
+        label: Some("probe"),
+        address_mode_u: wgpu::AddressMode::Repeat,
+        address_mode_v: wgpu::AddressMode::ClampToEdge,
+        address_mode_w: wgpu::AddressMode::ClampToEdge,
+        mag_filter: wgpu::FilterMode::Linear,
+        min_filter: wgpu::FilterMode::Linear,
+        mipmap_filter: wgpu::MipmapFilterMode::Linear,
+        ..Default::default()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
