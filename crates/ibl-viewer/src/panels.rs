@@ -11,33 +11,12 @@ use ibl_scene::description::{CompositeRule, MaterialDescription, MaterialKind, R
 
 use crate::probe_pass::{ProbeLayer, ProbeProjection};
 use crate::scene_renderer::GlossySource;
+pub use crate::view_state::PointerInput;
 use crate::view_state::{Content, ProbeState, SceneCamera, SceneState};
 use crate::window::ViewerApp;
 
 /// Width of the side panel, points.
 pub const SIDE_PANEL_WIDTH: f32 = 290.0;
-
-/// The pointer state the views need beyond a widget's response.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct PointerInput {
-    /// Wheel movement this frame, points (positive: away from the user).
-    pub scroll: f32,
-    /// Shift held.
-    pub shift: bool,
-    /// Ctrl (Cmd on macOS) held.
-    pub ctrl: bool,
-}
-
-impl PointerInput {
-    /// The pointer state of a frame's input.
-    pub fn of(input: &egui::InputState) -> PointerInput {
-        PointerInput {
-            scroll: input.smooth_scroll_delta.y,
-            shift: input.modifiers.shift,
-            ctrl: input.modifiers.command,
-        }
-    }
-}
 
 /// The light sources a user can pick.
 fn sources() -> Vec<ModelSpec> {

@@ -17,7 +17,6 @@ use crate::lighting::{
     ProbeOverlay, ProbeOverlayRequest, SceneLighting, SceneLightingRequest, probe_overlay,
     scene_lighting,
 };
-use crate::panels::PointerInput;
 use crate::probe_model::{ProbeModel, ProbeViewSettings};
 use crate::probe_pass::ProbeProjection;
 use crate::probe_renderer::ProbeRenderer;
@@ -643,5 +642,27 @@ impl ProbeState {
     /// Whether the overlay is being computed.
     pub fn overlay_busy(&self) -> bool {
         self.worker.busy()
+    }
+}
+
+/// The pointer state the views need beyond a widget's response.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PointerInput {
+    /// Wheel movement this frame, points (positive: away from the user).
+    pub scroll: f32,
+    /// Shift held.
+    pub shift: bool,
+    /// Ctrl (Cmd on macOS) held.
+    pub ctrl: bool,
+}
+
+impl PointerInput {
+    /// The pointer state of a frame's input.
+    pub fn of(input: &egui::InputState) -> PointerInput {
+        PointerInput {
+            scroll: input.smooth_scroll_delta.y,
+            shift: input.modifiers.shift,
+            ctrl: input.modifiers.command,
+        }
     }
 }
