@@ -70,12 +70,8 @@ pub const MAX_AMBIENT_BANDS: usize = 16;
 /// The ambient of the `hybrid` mode: an SH radiance, world frame, seen through occlusion rays.
 #[derive(Clone, Debug)]
 pub struct Ambient {
-    /// Bands of `radiance`, 1 to [`MAX_AMBIENT_BANDS`].
-    bands: usize,
-    /// `bands^2` RGB coefficients of the ambient radiance (probe units), world frame.
-    coefficients: Vec<[f64; 3]>,
-    /// The same radiance as an SH expansion, for front ends that draw it (the viewer's
-    /// irradiance map).
+    /// The ambient radiance (probe units, world frame), cut to at most [`MAX_AMBIENT_BANDS`]
+    /// bands.
     sh: RadianceSh,
     /// Occlusion rays per shading point, at least 1.
     pub occlusion_rays: u32,
@@ -85,13 +81,8 @@ impl Ambient {
     /// The ambient of radiance `radiance` (world frame; its bands are cut to
     /// [`MAX_AMBIENT_BANDS`]) with `occlusion_rays` rays per shading point (at least 1).
     pub fn new(radiance: &RadianceSh, occlusion_rays: u32) -> Ambient {
-        let bands = radiance.bands().clamp(1, MAX_AMBIENT_BANDS);
-        let mut coefficients = radiance.coefficients().to_vec();
-        coefficients.resize(bands * bands, [0.0; 3]);
         Ambient {
-            bands,
-            coefficients,
-            sh: radiance.truncated(bands),
+            sh: radiance.truncated(MAX_AMBIENT_BANDS),
             occlusion_rays: occlusion_rays.max(1),
         }
     }
@@ -105,10 +96,11 @@ impl Ambient {
     /// the ambient is a difference). O(bands^2).
     pub fn radiance(&self, dir: Vec3) -> Rgb {
         let mut y = [0.0f64; MAX_AMBIENT_BANDS * MAX_AMBIENT_BANDS];
-        let n = self.bands * self.bands;
-        eval_basis(dir.as_dvec3(), self.bands, &mut y[..n]);
+        let bands = self.sh.bands();
+        let n = bands * bands;
+        eval_basis(dir.as_dvec3(), bands, &mut y[..n]);
         let mut sum = [0.0f64; 3];
-        for (c, yk) in self.coefficients.iter().zip(&y[..n]) {
+        for (c, yk) in self.sh.coefficients().iter().zip(&y[..n]) {
             for k in 0..3 {
                 sum[k] += c[k] * yk;
             }
