@@ -202,7 +202,6 @@ fn a_shape_that_names_no_mapping_is_refused_by_every_probe_command() {
         vec!["sh", p],
         vec!["irradiance", p, "--csv", &o_csv],
         vec!["eval", p, "-n", "2", "--out", s(&out)],
-        vec!["info", p],
     ] {
         let o = ibl(&args);
         let e = stderr(&o);
@@ -210,6 +209,20 @@ fn a_shape_that_names_no_mapping_is_refused_by_every_probe_command() {
         assert!(e.contains(p) && e.contains("40 x 60"), "{args:?}: {e}");
         assert!(!out.with_extension("json").exists() && !out.exists());
     }
+    // `ibl info` describes any image: it says the mapping is unknown and leaves out what needs
+    // one (power, the brightest direction) instead of refusing.
+    let o = ibl(&["info", p, "--json"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["mapping"], "unknown");
+    assert_eq!(
+        (v["width"].as_u64(), v["height"].as_u64()),
+        (Some(40), Some(60))
+    );
+    assert!(
+        v["power"].is_null() && v["brightest"]["direction"].is_null(),
+        "{v}"
+    );
     // Named explicitly, the same image is accepted as lat-long.
     run_ok(&["sh", p, "--mapping", "latlong"]);
 }

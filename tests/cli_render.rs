@@ -518,6 +518,8 @@ fn a_photo_background_composites_back_to_the_photo_when_empty() {
         "lights",
         "-n",
         "4",
+        "--spp",
+        "2",
         "--json",
     ]);
     let v = summary(&o, "lights", (48, 36));

@@ -93,7 +93,7 @@ fn print_summary(out: &Path, results: &[ProbeResult]) {
     );
     for r in results {
         let i = &r.info;
-        let [pr, pg, pb] = i.power;
+        let [pr, pg, pb] = i.power.unwrap_or_default(); // the demo's probes are lat-long
         let power_lum = Rgb64 {
             r: pr,
             g: pg,

@@ -55,6 +55,8 @@ pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
 fn print_text(i: &Info) {
     let guessed = if i.mapping_guessed {
         " (guessed from shape; --mapping to override)"
+    } else if i.mapping == ibl_pipeline::info::UNKNOWN_MAPPING {
+        " (its shape names none: not read as a probe; --mapping to name one)"
     } else {
         ""
     };
@@ -75,10 +77,13 @@ fn print_text(i: &Info) {
         "mean        {:>12.5e} {:>12.5e} {:>12.5e}",
         i.mean[0], i.mean[1], i.mean[2]
     );
-    println!(
-        "power       {:>12.5e} {:>12.5e} {:>12.5e}   (sum L dOmega)",
-        i.power[0], i.power[1], i.power[2]
-    );
+    match i.power {
+        Some(p) => println!(
+            "power       {:>12.5e} {:>12.5e} {:>12.5e}   (sum L dOmega)",
+            p[0], p[1], p[2]
+        ),
+        None => println!("power       needs a mapping: name one with --mapping"),
+    }
     let dr = &i.dynamic_range;
     println!(
         "range       luminance {:.3e} .. {:.3e}: {:.3e}:1 ({:.1} stops)",
@@ -89,16 +94,15 @@ fn print_text(i: &Info) {
         i.negative_values, i.nonfinite_values, i.raw_min[0], i.raw_min[1], i.raw_min[2]
     );
     let b = &i.brightest;
+    let direction = match b.direction {
+        Some(d) => format!(
+            "direction ({:+.4}, {:+.4}, {:+.4}) [{} axes], ",
+            d[0], d[1], d[2], i.frame
+        ),
+        None => String::new(),
+    };
     println!(
-        "brightest   direction ({:+.4}, {:+.4}, {:+.4}) [{} axes], pixel ({}, {}), radiance ({:.4e}, {:.4e}, {:.4e})",
-        b.direction[0],
-        b.direction[1],
-        b.direction[2],
-        i.frame,
-        b.pixel[0],
-        b.pixel[1],
-        b.radiance[0],
-        b.radiance[1],
-        b.radiance[2]
+        "brightest   {direction}pixel ({}, {}), radiance ({:.4e}, {:.4e}, {:.4e})",
+        b.pixel[0], b.pixel[1], b.radiance[0], b.radiance[1], b.radiance[2]
     );
 }

@@ -96,14 +96,15 @@ fn mapping(name: &str) -> Result<EnvMapping, String> {
 }
 
 fn target(name: &str) -> Result<EngineTarget, String> {
-    EngineTarget::from_name(name)
-        .ok_or_else(|| format!("unknown target `{name}` (khronos, bevy, filament, unity, threejs)"))
+    EngineTarget::from_name(name).ok_or_else(|| {
+        format!("unknown --target `{name}` (khronos, bevy, filament, unity, threejs)")
+    })
 }
 
 fn texel_format(name: &str) -> Result<TexelFormat, String> {
     TexelFormat::from_name(name)
         .filter(|f| f.channels() == 3)
-        .ok_or_else(|| format!("unknown format `{name}` (rgba16f, rgba32f, rgb9e5)"))
+        .ok_or_else(|| format!("unknown --format `{name}` (rgba16f, rgba32f, rgb9e5)"))
 }
 
 fn dfg_layout(name: &str) -> Result<DfgLayout, String> {

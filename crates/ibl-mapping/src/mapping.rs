@@ -302,6 +302,7 @@ mod tests {
             Mapping::Cube(CubeLayout::HorizontalCross),
             Mapping::Cube(CubeLayout::VerticalCross),
             Mapping::Cube(CubeLayout::HorizontalStrip),
+            Mapping::Cube(CubeLayout::VerticalStrip),
             Mapping::Fisheye { fov_deg: 180.0 },
             Mapping::DualFisheye { fov_deg: 195.5 },
         ];

@@ -107,6 +107,9 @@ pub fn write_summary(
     );
     for r in results {
         let i = &r.info;
+        // The demo's probes are lat-long: both are always known.
+        let power = i.power.unwrap_or_default();
+        let brightest = i.brightest.direction.unwrap_or_default();
         let _ = write!(
             html,
             "<h2>{}</h2><p>{} x {} {} &middot; power {:.4e} {:.4e} {:.4e} &middot; dynamic range {:.1} stops \
@@ -115,13 +118,13 @@ pub fn write_summary(
             i.width,
             i.height,
             i.format,
-            i.power[0],
-            i.power[1],
-            i.power[2],
+            power[0],
+            power[1],
+            power[2],
             i.dynamic_range.stops,
-            i.brightest.direction[0],
-            i.brightest.direction[1],
-            i.brightest.direction[2],
+            brightest[0],
+            brightest[1],
+            brightest[2],
             i.negative_values,
             i.nonfinite_values
         );

@@ -141,12 +141,18 @@ pub fn load(path: &Path, mapping: Option<EnvMapping>) -> Result<LoadedEnv> {
     if mapping == Some(EnvMapping::CubeFaces) {
         return load_faces(path);
     }
+    bind(path, ibl_io::read_image(path)?, mapping)
+}
+
+/// Binds an image read from `path` to `mapping` or, when `None`, to the mapping its shape names
+/// (a shape that names none is refused), after checking the shape fits.
+pub fn bind(path: &Path, loaded: LoadedImage, mapping: Option<EnvMapping>) -> Result<LoadedEnv> {
     let LoadedImage {
         image,
         format,
         report,
         details,
-    } = ibl_io::read_image(path)?;
+    } = loaded;
     let mapping = match mapping {
         Some(m) => m.in_memory(),
         None => Mapping::detect_from_shape(image.width(), image.height())

@@ -8,15 +8,33 @@ use std::path::Path;
 use ibl_core::{FramePreset, Image, Rgb};
 use serde::Serialize;
 
+use ibl_io::{ImageFormat, LoadedImage, SanitizeReport};
+use ibl_mapping::Mapping;
+
 use crate::envmap_files::{self, EnvMapping, LoadedEnv};
 use crate::error::Result;
 
 /// Reads `path` (in `mapping`, or guessed from its shape when `None`) and describes it, the
 /// brightest direction in `frame`'s axes. Cost O(W H).
 pub fn probe_info(path: &Path, mapping: Option<EnvMapping>, frame: FramePreset) -> Result<Info> {
-    let env = envmap_files::load(path, mapping)?;
+    if mapping == Some(EnvMapping::CubeFaces) {
+        let env = envmap_files::load(path, mapping)?;
+        return Ok(describe(&env, false, frame, &path.display().to_string()));
+    }
+    let loaded = ibl_io::read_image(path)?;
+    let (w, h) = (loaded.image.width(), loaded.image.height());
+    if mapping.is_none() && Mapping::detect_from_shape(w, h).is_none() {
+        // Not a probe by its shape (a photo, a strip of samples): still an image worth
+        // describing, without the quantities that need a mapping.
+        return Ok(describe_unmapped(
+            &loaded,
+            frame,
+            &path.display().to_string(),
+        ));
+    }
     // A KTX2/DDS cube map says it is one: its mapping is read, not guessed.
-    let cube_texture = env.format.is_texture() && env.details.contains("cube");
+    let cube_texture = loaded.format.is_texture() && loaded.details.contains("cube");
+    let env = envmap_files::bind(path, loaded, mapping)?;
     Ok(describe(
         &env,
         mapping.is_none() && !cube_texture,
@@ -25,11 +43,40 @@ pub fn probe_info(path: &Path, mapping: Option<EnvMapping>, frame: FramePreset) 
     ))
 }
 
+/// Describes an image whose shape names no mapping: statistics over every pixel, no power and
+/// no direction (those need a mapping: `--mapping` gives one).
+pub fn describe_unmapped(loaded: &LoadedImage, frame: FramePreset, file: &str) -> Info {
+    let img = &loaded.image;
+    let ones = Image::filled(img.width(), img.height(), 1.0);
+    let stats = channel_stats(img, &ones);
+    Info {
+        mapping: UNKNOWN_MAPPING.to_string(),
+        mapping_guessed: false,
+        power: None,
+        ..info_of(
+            img,
+            &stats,
+            &FileFacts {
+                format: loaded.format,
+                details: &loaded.details,
+                report: loaded.report,
+            },
+            None,
+            frame,
+            file,
+        )
+    }
+}
+
+/// The mapping name `ibl info` reports for an image whose shape names none.
+pub const UNKNOWN_MAPPING: &str = "unknown";
+
 /// The brightest pixel.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Brightest {
-    /// Unit direction towards it, in the requested frame's axes.
-    pub direction: [f32; 3],
+    /// Unit direction towards it, in the requested frame's axes (`None` when the image's
+    /// mapping is unknown).
+    pub direction: Option<[f32; 3]>,
     /// Pixel `[x, y]`, row 0 at the top.
     pub pixel: [usize; 2],
     /// Its radiance (linear RGB).
@@ -62,7 +109,7 @@ pub struct Info {
     pub format: String,
     /// Encoding details.
     pub encoding: String,
-    /// Mapping used.
+    /// Mapping used (`unknown` when the shape names none and none was given).
     pub mapping: String,
     /// Whether the mapping was guessed from the shape.
     pub mapping_guessed: bool,
@@ -78,8 +125,9 @@ pub struct Info {
     pub negative_values: u64,
     /// Channel values that were NaN or infinite (clamped to 0).
     pub nonfinite_values: u64,
-    /// Total power per channel, `sum L dOmega` (radiance unit x sr).
-    pub power: [f64; 3],
+    /// Total power per channel, `sum L dOmega` (radiance unit x sr); `None` when the mapping
+    /// is unknown.
+    pub power: Option<[f64; 3]>,
     /// Luminance dynamic range.
     pub dynamic_range: DynamicRange,
     /// Frame of `brightest.direction`.
@@ -91,21 +139,54 @@ pub struct Info {
 /// Computes the statistics of a loaded environment map. Cost O(W H).
 pub fn describe(env: &LoadedEnv, guessed: bool, frame: FramePreset, file: &str) -> Info {
     let img = &env.image;
-    let (w, h) = (img.width(), img.height());
-    let solid = env.mapping.texel_solid_angles(w, h);
+    let solid = env.mapping.texel_solid_angles(img.width(), img.height());
     let stats = channel_stats(img, &solid);
-    let power = ibl_mapping::power(img, env.mapping);
-    let dir = env
-        .mapping
-        .pixel_dir(
+    let facts = FileFacts {
+        format: env.format,
+        details: &env.details,
+        report: env.report,
+    };
+    Info {
+        mapping: env.mapping.name(),
+        mapping_guessed: guessed,
+        power: Some(ibl_mapping::power(img, env.mapping)),
+        ..info_of(img, &stats, &facts, Some(env.mapping), frame, file)
+    }
+}
+
+/// What the file said about itself, beside its pixels.
+struct FileFacts<'a> {
+    format: ImageFormat,
+    details: &'a str,
+    report: SanitizeReport,
+}
+
+/// The fields every description shares; `mapping` places the brightest pixel in the world.
+fn info_of(
+    img: &Image<Rgb>,
+    stats: &ChannelStats,
+    loaded: &FileFacts<'_>,
+    mapping: Option<Mapping>,
+    frame: FramePreset,
+    file: &str,
+) -> Info {
+    let (w, h) = (img.width(), img.height());
+    let direction = mapping.map(|m| {
+        m.pixel_dir(
             w,
             h,
             stats.brightest.0 as f64 + 0.5,
             stats.brightest.1 as f64 + 0.5,
         )
         .map(|d| frame.preset_from_world() * d.as_vec3())
-        .unwrap_or_default();
-    let b = *img.get(stats.brightest.0, stats.brightest.1);
+        .unwrap_or_default()
+        .to_array()
+    });
+    let b = if w > 0 && h > 0 {
+        *img.get(stats.brightest.0, stats.brightest.1)
+    } else {
+        Rgb::ZERO
+    };
     let ratio = if stats.min_pos_lum > 0.0 && stats.min_pos_lum.is_finite() {
         f64::from(stats.max_lum) / f64::from(stats.min_pos_lum)
     } else {
@@ -115,17 +196,17 @@ pub fn describe(env: &LoadedEnv, guessed: bool, frame: FramePreset, file: &str) 
         file: file.to_string(),
         width: w,
         height: h,
-        format: env.format.name().to_string(),
-        encoding: env.details.clone(),
-        mapping: env.mapping.name(),
-        mapping_guessed: guessed,
+        format: loaded.format.name().to_string(),
+        encoding: loaded.details.to_string(),
+        mapping: UNKNOWN_MAPPING.to_string(),
+        mapping_guessed: false,
         min: stats.min.to_array(),
         max: stats.max.to_array(),
         mean: stats.mean,
-        raw_min: env.report.raw_min.to_array(),
-        negative_values: env.report.negative_values,
-        nonfinite_values: env.report.nonfinite_values,
-        power,
+        raw_min: loaded.report.raw_min.to_array(),
+        negative_values: loaded.report.negative_values,
+        nonfinite_values: loaded.report.nonfinite_values,
+        power: None,
         dynamic_range: DynamicRange {
             min_positive_luminance: if stats.min_pos_lum.is_finite() {
                 stats.min_pos_lum
@@ -138,7 +219,7 @@ pub fn describe(env: &LoadedEnv, guessed: bool, frame: FramePreset, file: &str) 
         },
         frame: frame.name().to_string(),
         brightest: Brightest {
-            direction: dir.to_array(),
+            direction,
             pixel: [stats.brightest.0, stats.brightest.1],
             radiance: b.to_array(),
         },

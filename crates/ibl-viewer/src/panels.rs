@@ -11,9 +11,7 @@ use ibl_scene::description::{CompositeRule, MaterialDescription, MaterialKind, R
 
 use crate::probe_pass::{ProbeLayer, ProbeProjection};
 use crate::scene_renderer::GlossySource;
-pub use crate::view_state::PointerInput;
 use crate::view_state::{Content, ProbeState, SceneCamera, SceneState};
-use crate::window::ViewerApp;
 
 /// Width of the side panel, points.
 pub const SIDE_PANEL_WIDTH: f32 = 290.0;
@@ -424,44 +422,62 @@ fn material_controls(ui: &mut egui::Ui, m: &mut MaterialDescription) {
     }
 }
 
-/// The side panel.
-pub fn side_panel(ui: &mut egui::Ui, app: &mut ViewerApp) {
+/// What the user asked for in the side panel this frame; the window carries it out.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PanelRequests {
+    /// "save frame" was pressed.
+    pub save_frame: bool,
+    /// "save scene" was pressed.
+    pub save_scene: bool,
+    /// A material was edited: the GPU copy must be rewritten.
+    pub materials_changed: bool,
+}
+
+/// The side panel for what is open.
+pub fn side_panel(ui: &mut egui::Ui, content: &mut Content) -> PanelRequests {
+    let mut requests = PanelRequests::default();
     egui::Panel::right("controls")
         .default_size(SIDE_PANEL_WIDTH)
         .show(ui, |ui| {
             egui::ScrollArea::vertical().show(ui, |ui| {
-                let mut materials_changed = false;
-                match &mut app.content {
+                match content {
                     Content::Empty => {
                         ui.heading("ibl view");
                         ui.label("Drop a probe (.exr, .hdr, .pfm, ...) or a scene (.toml) here.");
                     }
                     Content::Probe(p) => probe_panel(ui, p),
-                    Content::Scene(s) => scene_panel(ui, s, &mut materials_changed),
+                    Content::Scene(s) => scene_panel(ui, s, &mut requests.materials_changed),
                 }
                 ui.separator();
                 ui.horizontal(|ui| {
-                    if ui.button("save frame (F12)").clicked() {
-                        app.save_frame();
-                    }
-                    if matches!(app.content, Content::Scene(_)) && ui.button("save scene").clicked()
-                    {
-                        app.save_scene(None);
-                    }
+                    requests.save_frame = ui.button("save frame (F12)").clicked();
+                    requests.save_scene =
+                        matches!(content, Content::Scene(_)) && ui.button("save scene").clicked();
                 });
-                if materials_changed {
-                    app.materials_changed();
-                }
             });
         });
+    requests
+}
+
+/// What the status line reports beside the content.
+#[derive(Clone, Copy, Debug)]
+pub struct StatusLine<'a> {
+    /// Frames per second over the last second.
+    pub fps: f64,
+    /// The GPU adapter, one line.
+    pub adapter: &'a str,
+    /// The last error, shown in red until the next successful action.
+    pub error: Option<&'a str>,
+    /// The last message (opened or saved files).
+    pub message: Option<&'a str>,
 }
 
 /// The status line.
-pub fn status_bar(ui: &mut egui::Ui, app: &ViewerApp) {
+pub fn status_bar(ui: &mut egui::Ui, content: &Content, status: StatusLine<'_>) {
     egui::Panel::bottom("status").show(ui, |ui| {
         ui.horizontal(|ui| {
-            ui.label(format!("{:.1} fps", app.fps()));
-            match &app.content {
+            ui.label(format!("{:.1} fps", status.fps));
+            match content {
                 Content::Scene(s) => {
                     let lights = s.lighting().map_or(0, |l| l.lights.len());
                     ui.label(format!(
@@ -485,10 +501,10 @@ pub fn status_bar(ui: &mut egui::Ui, app: &ViewerApp) {
                 }
                 Content::Empty => {}
             }
-            ui.label(app.adapter_line());
-            if let Some(e) = &app.error {
+            ui.label(status.adapter);
+            if let Some(e) = status.error {
                 ui.colored_label(egui::Color32::from_rgb(255, 110, 100), e);
-            } else if let Some(m) = &app.message {
+            } else if let Some(m) = status.message {
                 ui.label(m);
             }
         });
@@ -496,11 +512,16 @@ pub fn status_bar(ui: &mut egui::Ui, app: &ViewerApp) {
 }
 
 /// Text over the view when nothing is shown.
-pub fn central_messages(ui: &mut egui::Ui, app: &ViewerApp, rect: egui::Rect) {
-    if !matches!(app.content, Content::Empty) {
+pub fn central_messages(
+    ui: &mut egui::Ui,
+    content: &Content,
+    error: Option<&str>,
+    rect: egui::Rect,
+) {
+    if !matches!(content, Content::Empty) {
         return;
     }
-    let text = match &app.error {
+    let text = match error {
         Some(e) => format!("{e}\n\nDrop a probe or a scene file onto the window."),
         None => "Drop a probe or a scene file onto the window.".to_string(),
     };

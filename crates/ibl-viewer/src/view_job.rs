@@ -325,10 +325,11 @@ impl ViewSummary {
         let gpu = t
             .gpu_ms_median
             .map_or(String::new(), |g| format!(", GPU {g:.1} ms"));
-        let lights = if s.lights > 0 && s.shadow_map_texels > 0 {
-            format!(", {}, shadow maps {}^2", s.lighting, s.shadow_map_texels)
-        } else {
-            String::new()
+        // A scene's lights cast shadows; a probe's lights are only drawn over it.
+        let lights = match (s.lights, s.shadow_map_texels) {
+            (0, _) => String::new(),
+            (_, 0) => format!(", {}", s.lighting),
+            (_, texels) => format!(", {}, shadow maps {texels}^2", s.lighting),
         };
         let wrote = if s.outputs.is_empty() {
             String::new()

@@ -25,7 +25,7 @@ use ibl_mapping::Mapping;
 use crate::ViewerError;
 use crate::gpu::GpuContext;
 use crate::panels;
-use crate::view_state::{Content, ViewEvent};
+use crate::view_state::{Content, PointerInput, ViewEvent};
 
 /// How the window starts.
 #[derive(Clone, Debug, PartialEq)]
@@ -387,8 +387,24 @@ impl ViewerApp {
         if let Err(e) = self.content.poll_workers(&self.gpu) {
             self.error = Some(e);
         }
-        panels::status_bar(ui, self);
-        panels::side_panel(ui, self);
+        let adapter = self.adapter_line();
+        let status = panels::StatusLine {
+            fps: self.fps(),
+            adapter: &adapter,
+            error: self.error.as_deref(),
+            message: self.message.as_deref(),
+        };
+        panels::status_bar(ui, &self.content, status);
+        let requests = panels::side_panel(ui, &mut self.content);
+        if requests.save_frame {
+            self.save_frame();
+        }
+        if requests.save_scene {
+            self.save_scene(None);
+        }
+        if requests.materials_changed {
+            self.materials_changed();
+        }
         egui::CentralPanel::default()
             .frame(egui::Frame::NONE.fill(egui::Color32::from_gray(24)))
             .show(ui, |ui| {
@@ -408,10 +424,10 @@ impl ViewerApp {
                     .targets()
                     .map(|t| self.content.display_rect(rect, t.size));
                 if let Some(shown) = shown {
-                    let input = ctx.input(panels::PointerInput::of);
+                    let input = ctx.input(PointerInput::of);
                     self.content.pointer(&response, shown, &input);
                 }
-                panels::central_messages(ui, self, rect);
+                panels::central_messages(ui, &self.content, self.error.as_deref(), rect);
             });
         self.frames_drawn += 1;
         self.screenshot(&ctx);
