@@ -22,7 +22,8 @@ pub struct InfoArgs {
     /// The image to describe (.hdr, .exr, .pfm, .png, .jpg; .ktx2 and .dds: level 0, a cube map
     /// as its six faces side by side).
     pub file: PathBuf,
-    /// Mapping of the image (default: guessed from its shape; 2:1 is lat-long, 1:1 angular).
+    /// Mapping of the image (default: guessed from its shape; 2:1 is lat-long, 1:1 angular; a
+    /// shape that names none is described without its power and brightest direction).
     #[arg(long, value_name = "MAPPING")]
     pub mapping: Option<String>,
     /// Field of view in degrees for the fisheye mappings.
