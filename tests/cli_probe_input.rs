@@ -213,7 +213,7 @@ fn a_shape_that_names_no_mapping_is_refused_by_every_probe_command() {
     // one (power, the brightest direction) instead of refusing.
     let o = ibl(&["info", p, "--json"]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
-    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let v = json(&o.stdout);
     assert_eq!(v["mapping"], "unknown");
     assert_eq!(
         (v["width"].as_u64(), v["height"].as_u64()),

@@ -45,27 +45,16 @@ pub fn probe_info(path: &Path, mapping: Option<EnvMapping>, frame: FramePreset) 
 
 /// Describes an image whose shape names no mapping: statistics over every pixel, no power and
 /// no direction (those need a mapping: `--mapping` gives one).
-pub fn describe_unmapped(loaded: &LoadedImage, frame: FramePreset, file: &str) -> Info {
+fn describe_unmapped(loaded: &LoadedImage, frame: FramePreset, file: &str) -> Info {
     let img = &loaded.image;
     let ones = Image::filled(img.width(), img.height(), 1.0);
     let stats = channel_stats(img, &ones);
-    Info {
-        mapping: UNKNOWN_MAPPING.to_string(),
-        mapping_guessed: false,
-        power: None,
-        ..info_of(
-            img,
-            &stats,
-            &FileFacts {
-                format: loaded.format,
-                details: &loaded.details,
-                report: loaded.report,
-            },
-            None,
-            frame,
-            file,
-        )
-    }
+    let facts = FileFacts {
+        format: loaded.format,
+        details: &loaded.details,
+        report: loaded.report,
+    };
+    info_of(img, &stats, &facts, None, frame, file)
 }
 
 /// The mapping name `ibl info` reports for an image whose shape names none.
@@ -146,12 +135,18 @@ pub fn describe(env: &LoadedEnv, guessed: bool, frame: FramePreset, file: &str) 
         details: &env.details,
         report: env.report,
     };
-    Info {
-        mapping: env.mapping.name(),
-        mapping_guessed: guessed,
-        power: Some(ibl_mapping::power(img, env.mapping)),
-        ..info_of(img, &stats, &facts, Some(env.mapping), frame, file)
-    }
+    let bound = BoundMapping {
+        mapping: env.mapping,
+        guessed,
+    };
+    info_of(img, &stats, &facts, Some(bound), frame, file)
+}
+
+/// The mapping an image is described in, and whether it was guessed from the shape.
+#[derive(Clone, Copy)]
+struct BoundMapping {
+    mapping: Mapping,
+    guessed: bool,
 }
 
 /// What the file said about itself, beside its pixels.
@@ -161,26 +156,27 @@ struct FileFacts<'a> {
     report: SanitizeReport,
 }
 
-/// The fields every description shares; `mapping` places the brightest pixel in the world.
+/// The description; without a mapping there is no power and no direction to the brightest pixel.
 fn info_of(
     img: &Image<Rgb>,
     stats: &ChannelStats,
     loaded: &FileFacts<'_>,
-    mapping: Option<Mapping>,
+    bound: Option<BoundMapping>,
     frame: FramePreset,
     file: &str,
 ) -> Info {
     let (w, h) = (img.width(), img.height());
-    let direction = mapping.map(|m| {
-        m.pixel_dir(
-            w,
-            h,
-            stats.brightest.0 as f64 + 0.5,
-            stats.brightest.1 as f64 + 0.5,
-        )
-        .map(|d| frame.preset_from_world() * d.as_vec3())
-        .unwrap_or_default()
-        .to_array()
+    let direction = bound.map(|b| {
+        b.mapping
+            .pixel_dir(
+                w,
+                h,
+                stats.brightest.0 as f64 + 0.5,
+                stats.brightest.1 as f64 + 0.5,
+            )
+            .map(|d| frame.preset_from_world() * d.as_vec3())
+            .unwrap_or_default()
+            .to_array()
     });
     let b = if w > 0 && h > 0 {
         *img.get(stats.brightest.0, stats.brightest.1)
@@ -198,15 +194,15 @@ fn info_of(
         height: h,
         format: loaded.format.name().to_string(),
         encoding: loaded.details.to_string(),
-        mapping: UNKNOWN_MAPPING.to_string(),
-        mapping_guessed: false,
+        mapping: bound.map_or(UNKNOWN_MAPPING.to_string(), |b| b.mapping.name()),
+        mapping_guessed: bound.is_some_and(|b| b.guessed),
         min: stats.min.to_array(),
         max: stats.max.to_array(),
         mean: stats.mean,
         raw_min: loaded.report.raw_min.to_array(),
         negative_values: loaded.report.negative_values,
         nonfinite_values: loaded.report.nonfinite_values,
-        power: None,
+        power: bound.map(|b| ibl_mapping::power(img, b.mapping)),
         dynamic_range: DynamicRange {
             min_positive_luminance: if stats.min_pos_lum.is_finite() {
                 stats.min_pos_lum
