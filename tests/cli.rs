@@ -304,6 +304,26 @@ fn demo_writes_every_mapping_and_an_index() {
         serde_json::from_slice(&std::fs::read(out_dir.join("summary.json")).unwrap()).unwrap();
     let probes = summary["probes"].as_array().unwrap();
     assert_eq!(probes.len(), 5);
+    // The viewer's section (issue 15): a headless frame of each example scene with its timings;
+    // without a GPU adapter it says so, which only a machine outside CI may lack.
+    let sections = summary["sections"].as_array().unwrap();
+    let viewer = sections.iter().find(|s| s["id"] == "viewer").unwrap();
+    let frames = viewer["data"].as_array().unwrap();
+    assert_eq!(frames.len(), 2);
+    let in_ci = std::env::var("CI").is_ok_and(|v| !v.is_empty() && v != "false" && v != "0");
+    for f in frames {
+        if let Some(png) = f["frame"].as_str() {
+            assert!(out_dir.join(png).exists(), "{png}");
+            assert!(f["summary"]["statistics"]["fps_median"].as_f64().unwrap() > 0.0);
+        } else {
+            let error = f["error"].as_str().unwrap();
+            assert!(
+                !in_ci && error.contains("no usable GPU adapter"),
+                "{}: {error}",
+                f["scene"]
+            );
+        }
+    }
     for p in probes {
         for m in p["mappings"].as_array().unwrap() {
             assert!(out_dir.join(m["preview"].as_str().unwrap()).exists());

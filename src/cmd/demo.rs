@@ -63,7 +63,11 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
                 .unwrap_or_else(|| assets_dir().join("rooms/apartment/room.toml")),
         ),
     };
-    let made = demo(&options, &Bars::default())?;
+    let made = demo(
+        &options,
+        &Bars::default(),
+        &[&ibl_viewer::demo_frames::ViewerFrames],
+    )?;
     print_summary(&args.out, &made.probes);
     println!();
     print_lights_needed(&made.report);
@@ -82,6 +86,9 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
             room.patches,
             ibl_pipeline::demo_room::DEMO_IMPORTANT_PATCHES
         );
+    }
+    for s in &made.sections {
+        println!("  {}/index.html#{}  {}", args.out.display(), s.id, s.title);
     }
     Ok(())
 }

@@ -20,6 +20,7 @@ use crate::demo_paths::EVAL_DIR;
 use crate::demo_probe::{ProbeResult, demo_mappings, demo_probe};
 use crate::demo_render::{SceneResult, demo_renders};
 use crate::demo_room::{RoomResult, demo_room};
+use crate::demo_section::{DemoSection, PageSection};
 use crate::error::{Context, PipelineError, Result};
 use crate::eval::{EvalSettings, evaluate};
 use crate::progress::Progress;
@@ -49,6 +50,8 @@ pub struct Demo {
     pub renders: Vec<SceneResult>,
     /// The reconstructed room.
     pub room: Option<RoomResult>,
+    /// The front ends' sections.
+    pub sections: Vec<PageSection>,
 }
 
 /// Light counts of the demo's comparison: the powers of two 1 to 128. `ibl eval` also sweeps 256 by
@@ -95,8 +98,13 @@ pub fn list_probes(dir: &Path) -> Result<Vec<PathBuf>> {
     Ok(files)
 }
 
-/// Runs the demo (see the module doc).
-pub fn demo(o: &DemoOptions, progress: &dyn Progress) -> Result<Demo> {
+/// Runs the demo (see the module doc); each of `front_ends` adds a section to the page after the
+/// renders and the room.
+pub fn demo(
+    o: &DemoOptions,
+    progress: &dyn Progress,
+    front_ends: &[&dyn DemoSection],
+) -> Result<Demo> {
     let probes = list_probes(&o.probes)?;
     crate::output_paths::check_output_folder(&o.out)?;
     ibl_io::create_dir_all(&o.out)?;
@@ -140,11 +148,23 @@ pub fn demo(o: &DemoOptions, progress: &dyn Progress) -> Result<Demo> {
         Some(path) => Some(demo_room(path, &o.out, progress)?),
         None => None,
     };
-    crate::demo_page::write_summary(&o.out, &results, &report, &renders, room.as_ref())?;
+    let sections: Vec<PageSection> = front_ends
+        .iter()
+        .map(|f| f.section(&o.scenes, &o.out, progress))
+        .collect();
+    crate::demo_page::write_summary(
+        &o.out,
+        &results,
+        &report,
+        &renders,
+        room.as_ref(),
+        &sections,
+    )?;
     Ok(Demo {
         probes: results,
         report,
         renders,
         room,
+        sections,
     })
 }

@@ -10,6 +10,7 @@ use crate::demo_paths::EVAL_DIR;
 use crate::demo_probe::ProbeResult;
 use crate::demo_render::SceneResult;
 use crate::demo_room::{RoomResult, room_html};
+use crate::demo_section::PageSection;
 use crate::error::Result;
 
 /// The comparison section of `index.html`: links, the average plot and the lights-needed table.
@@ -75,6 +76,7 @@ pub fn write_summary(
     report: &ibl_eval::Report,
     renders: &[SceneResult],
     room: Option<&RoomResult>,
+    sections: &[PageSection],
 ) -> Result<()> {
     #[derive(Serialize)]
     struct Summary<'a> {
@@ -82,12 +84,15 @@ pub fn write_summary(
         renders: &'a [SceneResult],
         #[serde(skip_serializing_if = "Option::is_none")]
         room: Option<&'a RoomResult>,
+        #[serde(skip_serializing_if = "<[_]>::is_empty")]
+        sections: &'a [PageSection],
     }
     // Serialising plain data to a string cannot fail.
     let json = serde_json::to_string_pretty(&Summary {
         probes: results,
         renders,
         room,
+        sections,
     })
     .unwrap_or_default();
     ibl_io::write_atomically(&out.join("summary.json"), json.as_bytes())?;
@@ -161,6 +166,9 @@ pub fn write_summary(
     html.push_str(&renders_html(renders));
     if let Some(room) = room {
         html.push_str(&room_html(room));
+    }
+    for s in sections {
+        let _ = write!(html, "<h2 id=\"{}\">{}</h2>{}", s.id, s.title, s.html);
     }
     ibl_io::write_atomically(&out.join("index.html"), html.as_bytes())?;
     Ok(())

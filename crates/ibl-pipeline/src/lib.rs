@@ -38,6 +38,7 @@ pub mod demo_paths;
 pub mod demo_probe;
 pub mod demo_render;
 pub mod demo_room;
+pub mod demo_section;
 pub mod envmap_files;
 pub mod error;
 pub mod eval;

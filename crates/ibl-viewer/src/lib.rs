@@ -32,6 +32,7 @@
 //! the UI thread.
 
 pub mod command_line;
+pub mod demo_frames;
 pub mod display_pass;
 pub mod environment_maps;
 mod error;

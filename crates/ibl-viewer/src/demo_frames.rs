@@ -1,0 +1,132 @@
+//! The viewer's section of `ibl demo`'s page (issue 15): one headless frame of every example
+//! scene, with its timings, made by the same [`ViewJob`] as `ibl view SCENE --headless`. Without
+//! a GPU adapter the section says so and the demo goes on.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use ibl_core::tonemap::ToneCurve;
+use ibl_pipeline::Progress;
+use ibl_pipeline::demo_section::{DemoSection, PageSection};
+
+use crate::headless::{HeadlessOptions, Motion};
+use crate::probe_model::Overlays;
+use crate::view_job::{ProbeViewOptions, ViewJob, ViewSummary, is_scene};
+
+/// Folder of the frames inside the demo's output folder.
+pub const VIEWER_DIR: &str = "viewer";
+
+/// Frames per scene: the first compiles the shaders and draws both shadow atlases; the median of
+/// the other two is the steady frame time.
+pub const DEMO_FRAMES: u32 = 3;
+
+/// The viewer's demo section.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct ViewerFrames;
+
+fn job(scene: &Path, output: PathBuf) -> ViewJob {
+    ViewJob {
+        input: scene.to_path_buf(),
+        mapping: None,
+        output: Some(output),
+        frames: HeadlessOptions {
+            frames: DEMO_FRAMES,
+            motion: Motion::Still,
+            ..HeadlessOptions::default()
+        },
+        exposure_stops: None,
+        curve: ToneCurve::Reinhard,
+        method: None,
+        lights: None,
+        bands: None,
+        probe: ProbeViewOptions {
+            projection: Default::default(),
+            layer: Default::default(),
+            sharpen: 0.0,
+            overlays: Overlays {
+                lights: false,
+                regions: false,
+                dominant: false,
+            },
+        },
+    }
+}
+
+fn caption(name: &str, s: &ViewSummary) -> String {
+    let stats = &s.statistics;
+    let passes = s
+        .per_frame
+        .last()
+        .and_then(|f| f.passes_ms.as_ref())
+        .map(|p| {
+            p.iter()
+                .map(|(pass, ms)| format!("{pass} {ms:.1} ms"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        })
+        .unwrap_or_else(|| "no GPU timestamps".into());
+    format!(
+        "{name}: {} at {} x {}, {:.2} fps median ({:.1} ms a frame; last frame: {passes}) on {} ({})",
+        s.lighting,
+        s.width,
+        s.height,
+        stats.fps_median,
+        stats.frame_ms_median,
+        s.adapter.name,
+        s.adapter.backend
+    )
+}
+
+impl DemoSection for ViewerFrames {
+    fn section(&self, scenes: &Path, out: &Path, progress: &dyn Progress) -> PageSection {
+        let mut html = String::from(
+            "<p>Each example scene as the real-time viewer draws it: one headless frame of \
+             <code>ibl view SCENE --headless</code> (the same code as the window), its lights \
+             each with a shadow map, composited into the probe on the GPU.</p>",
+        );
+        let mut data = Vec::new();
+        let mut files = match ibl_io::list_dir(scenes) {
+            Ok(f) => f,
+            Err(e) => {
+                let _ = write!(html, "<p>No frames: {e}</p>");
+                Vec::new()
+            }
+        };
+        files.retain(|p| is_scene(p));
+        let dir = out.join(VIEWER_DIR);
+        if let Err(e) = ibl_io::create_dir_all(&dir) {
+            let _ = write!(html, "<p>No frames: {e}</p>");
+            files.clear();
+        }
+        for scene in &files {
+            let name = scene
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            let png = format!("{VIEWER_DIR}/{name}.png");
+            match job(scene, out.join(&png)).run(progress) {
+                Ok(summary) => {
+                    let _ = write!(
+                        html,
+                        "<figure><a href=\"{png}\"><img class=wide src=\"{png}\"></a>\
+                         <figcaption>{}</figcaption></figure>",
+                        caption(&name, &summary)
+                    );
+                    data.push(
+                        serde_json::json!({ "scene": name, "frame": png, "summary": summary }),
+                    );
+                }
+                Err(e) => {
+                    let _ = write!(html, "<p>{name}: no viewer frame: {e}</p>");
+                    data.push(serde_json::json!({ "scene": name, "error": e.to_string() }));
+                }
+            }
+        }
+        PageSection {
+            id: "viewer".into(),
+            title: "The real-time viewer".into(),
+            html,
+            data: serde_json::Value::Array(data),
+        }
+    }
+}
