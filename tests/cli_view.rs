@@ -12,12 +12,8 @@ mod common;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use common::{ibl, repo, stderr};
+use common::{ibl, in_ci, repo, stderr};
 use serde_json::Value;
-
-fn in_ci() -> bool {
-    std::env::var("CI").is_ok_and(|v| !v.is_empty() && v != "false" && v != "0")
-}
 
 /// Whether `out` failed for want of a GPU adapter (then the test is skipped, or fails in CI).
 fn no_adapter(out: &Output, test: &str) -> bool {

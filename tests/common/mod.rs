@@ -6,6 +6,11 @@
 use std::path::PathBuf;
 use std::process::{Command, Output};
 
+/// Whether the tests run under CI (`CI` set and not `false` or `0`), where a GPU adapter must exist.
+pub fn in_ci() -> bool {
+    std::env::var("CI").is_ok_and(|v| !v.is_empty() && v != "false" && v != "0")
+}
+
 /// The `ibl` binary under test: the one cargo built, or `IBL_TEST_BIN` when set (to run a new
 /// test against an older build and see it fail, as issue 13 asks of every fix).
 pub fn ibl_binary() -> PathBuf {

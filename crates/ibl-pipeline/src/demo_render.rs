@@ -13,7 +13,7 @@
 //! `renders/report.md` and its chart as SVG and PNG.
 
 use std::fmt::Write as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use ibl_core::tonemap::{Display, auto_exposure_stops};
 use ibl_core::{Image, Rgb};
@@ -96,10 +96,16 @@ fn against(test: &Image<Rgb>, reference: &Image<Rgb>) -> Result<(f64, f64)> {
     Ok((d.relative_mse, f.mean()))
 }
 
-/// Renders every scene (`*.toml`) in `dir` into `out/renders/`.
-pub fn demo_renders(dir: &Path, out: &Path, progress: &dyn Progress) -> Result<Vec<SceneResult>> {
+/// The demo's scene files: every `*.toml` in `dir`, sorted as `ibl_io::list_dir` sorts them.
+pub fn list_scenes(dir: &Path) -> Result<Vec<PathBuf>> {
     let mut scenes = ibl_io::list_dir(dir)?;
     scenes.retain(|p| p.extension().is_some_and(|e| e == "toml"));
+    Ok(scenes)
+}
+
+/// Renders every scene of [`list_scenes`] in `dir` into `out/renders/`.
+pub fn demo_renders(dir: &Path, out: &Path, progress: &dyn Progress) -> Result<Vec<SceneResult>> {
+    let scenes = list_scenes(dir)?;
     let mut results = Vec::new();
     for path in scenes {
         let name = path

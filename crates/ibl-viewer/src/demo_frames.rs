@@ -7,11 +7,12 @@ use std::path::{Path, PathBuf};
 
 use ibl_core::tonemap::ToneCurve;
 use ibl_pipeline::Progress;
+use ibl_pipeline::demo_render::list_scenes;
 use ibl_pipeline::demo_section::{DemoSection, PageSection};
 
 use crate::headless::{HeadlessOptions, Motion};
 use crate::probe_model::Overlays;
-use crate::view_job::{ProbeViewOptions, ViewJob, ViewSummary, is_scene};
+use crate::view_job::{ProbeViewOptions, ViewJob, ViewSummary};
 
 /// Folder of the frames inside the demo's output folder.
 pub const VIEWER_DIR: &str = "viewer";
@@ -85,14 +86,14 @@ impl DemoSection for ViewerFrames {
              each with a shadow map, composited into the probe on the GPU.</p>",
         );
         let mut data = Vec::new();
-        let mut files = match ibl_io::list_dir(scenes) {
+        // The scenes the demo rendered, so the two sections show the same ones.
+        let mut files = match list_scenes(scenes) {
             Ok(f) => f,
             Err(e) => {
                 let _ = write!(html, "<p>No frames: {e}</p>");
                 Vec::new()
             }
         };
-        files.retain(|p| is_scene(p));
         let dir = out.join(VIEWER_DIR);
         if let Err(e) = ibl_io::create_dir_all(&dir) {
             let _ = write!(html, "<p>No frames: {e}</p>");

@@ -7,10 +7,11 @@
 // its normal by 1.5 texels plus 2 sin(theta) texels and its depth lowered by 1 + 2 tan(theta)
 // texels (at most 9), theta the angle between the receiver's normal and the light: normal-offset
 // and slope-scaled depth bias against self-shadowing. A surface turning away from the light
-// covers more depth per texel, so a constant bias leaves acne near the terminator. Soft shadows (PCSS, Fernando 2005): a directional light of cone
-// half-angle a casts a penumbra `(d_receiver - d_blocker) tan a` wide; the mean blocker depth
-// comes from 12 taps over the widest penumbra possible, the visibility from 16 comparison taps
-// over that penumbra, rotated per pixel.
+// covers more depth per texel, so a constant bias leaves acne near the terminator.
+// Soft shadows (PCSS, Fernando 2005): a directional light of cone half-angle a casts a penumbra
+// `(d_receiver - d_blocker) tan a` wide; the mean blocker depth comes from 12 taps over the
+// widest penumbra possible, the visibility from 16 comparison taps over that penumbra, rotated
+// per pixel, both with a receiver-plane bias (below).
 
 const POISSON: array<vec2<f32>, 16> = array<vec2<f32>, 16>(
     vec2<f32>(-0.94201624, -0.39906216), vec2<f32>(0.94558609, -0.76890725),
