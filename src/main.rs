@@ -35,6 +35,7 @@ Examples:
   ibl render assets/scenes/bunny-sky.toml -o bunny.exr   the bunny composited into a probe
   ibl compare render.exr reference.exr       RMSE, relative MSE and FLIP of a render
   ibl capture merge IMG_*.jpg -o probe.exr   bracketed exposures to HDR
+  ibl outdoor assets/outdoor/courtyard/scene.toml --out day   sun and sky per frame, composites
   ibl view assets/scenes/bunny-sky.toml      real-time viewer: 16 shadowed lights, edit, save
 
 Exit codes: 0 success, 1 internal failure, 2 bad input or arguments.";
@@ -63,6 +64,8 @@ enum Command {
     Render(cmd::render::RenderArgs),
     /// The reconstructed room (Grosch 2005): calibrate marks, estimate reflectance, light patches.
     Room(cmd::room::RoomArgs),
+    /// Outdoor AR (Jensen et al. 2006): sun and sky per video frame, relit maps, composites.
+    Outdoor(cmd::outdoor::OutdoorArgs),
     /// Write a tone-mapped 8-bit preview (PNG or JPEG) of an HDR image.
     Preview(cmd::preview::PreviewArgs),
     /// Run the main job on the bundled probes and write everything to a folder.
@@ -96,6 +99,7 @@ fn main() -> ExitCode {
         Command::Render(args) => cmd::render::run(&args),
         Command::Capture(args) => cmd::capture::run(&args),
         Command::Room(args) => cmd::room::run(&args),
+        Command::Outdoor(args) => cmd::outdoor::run(&args),
         Command::Preview(args) => cmd::preview::run(&args),
         Command::Demo(args) => cmd::demo::run(&args),
         Command::View(args) => cmd::view::run(&args),

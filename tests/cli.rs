@@ -288,12 +288,61 @@ fn hostile_corpus_gives_clear_errors_and_exit_2() {
     }
 }
 
+/// The whole demo on the bundled data: the slow tier (about 3.5 minutes of CI's 2 cores, most of
+/// the test step's; `IBL_SLOW=1 bash .ci/run`). The main tier runs the same demo and the same
+/// checks on one probe and one scene ([`demo_on_one_probe_and_one_scene_writes_every_section`]).
 #[test]
+#[ignore = "slow tier: the whole demo on the bundled data; IBL_SLOW=1 bash .ci/run"]
 fn demo_writes_every_mapping_and_an_index() {
     let dir = tempfile::tempdir().unwrap();
     let out_dir = dir.path().join("demo");
     let out = ibl(&["demo", "--out", out_dir.to_str().unwrap()]);
-    assert!(out.status.success(), "{}", stderr(&out));
+    check_demo(
+        &out,
+        &out_dir,
+        &["apartment", "esplanade", "night", "sky", "sunset"],
+        2,
+    );
+}
+
+/// The demo with every section (mappings, comparison, renders and their study, room, outdoor
+/// sequence, viewer frames) on the sky probe and the bunny-sky scene, copied with what they
+/// name into a folder laid out as `assets/` is.
+#[test]
+fn demo_on_one_probe_and_one_scene_writes_every_section() {
+    let dir = tempfile::tempdir().unwrap();
+    let assets = repo().join("assets");
+    for (from, to) in [
+        ("probes/sky.exr", "probes/sky.exr"),
+        ("models/bunny.glb", "models/bunny.glb"),
+        ("scenes/bunny-sky.toml", "scenes/bunny-sky.toml"),
+    ] {
+        let to = dir.path().join(to);
+        std::fs::create_dir_all(to.parent().unwrap()).unwrap();
+        std::fs::copy(assets.join(from), to).unwrap();
+    }
+    let out_dir = dir.path().join("demo");
+    let out = ibl(&[
+        "demo",
+        "--out",
+        out_dir.to_str().unwrap(),
+        "--probes",
+        dir.path().join("probes").to_str().unwrap(),
+        "--scenes",
+        dir.path().join("scenes").to_str().unwrap(),
+    ]);
+    check_demo(&out, &out_dir, &["sky"], 1);
+}
+
+/// Checks a demo run on `probe_names` and `scene_count` scenes.
+#[allow(clippy::unwrap_used)] // a test's helper: a failure is the test's
+fn check_demo(
+    out: &std::process::Output,
+    out_dir: &Path,
+    probe_names: &[&str],
+    scene_count: usize,
+) {
+    assert!(out.status.success(), "{}", stderr(out));
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(
         stdout.contains(out_dir.to_str().unwrap()),
@@ -303,13 +352,25 @@ fn demo_writes_every_mapping_and_an_index() {
     let summary: serde_json::Value =
         serde_json::from_slice(&std::fs::read(out_dir.join("summary.json")).unwrap()).unwrap();
     let probes = summary["probes"].as_array().unwrap();
-    assert_eq!(probes.len(), 5);
+    let names: Vec<&str> = probes.iter().map(|p| p["name"].as_str().unwrap()).collect();
+    assert_eq!(names, probe_names);
+    let sections = summary["sections"].as_array().unwrap();
+    // The outdoor sequence (issue 18): every bundled frame estimated and composited.
+    let outdoor = sections.iter().find(|s| s["id"] == "outdoor").unwrap();
+    let frames = outdoor["data"]["summary"]["frames"].as_array().unwrap();
+    assert_eq!(frames.len(), 8);
+    for f in frames {
+        let png = std::path::Path::new("outdoor")
+            .join(f["composite"].as_str().unwrap())
+            .with_extension("png");
+        assert!(out_dir.join(&png).exists(), "{}", png.display());
+    }
+    assert!(out_dir.join("outdoor/estimates.svg").exists());
     // The viewer's section (issue 15): a headless frame of each example scene with its timings;
     // without a GPU adapter it says so, which only a machine outside CI may lack.
-    let sections = summary["sections"].as_array().unwrap();
     let viewer = sections.iter().find(|s| s["id"] == "viewer").unwrap();
     let frames = viewer["data"].as_array().unwrap();
-    assert_eq!(frames.len(), 2);
+    assert_eq!(frames.len(), scene_count);
     for f in frames {
         if let Some(png) = f["frame"].as_str() {
             assert!(out_dir.join(png).exists(), "{png}");
@@ -339,7 +400,12 @@ fn demo_writes_every_mapping_and_an_index() {
             }
         }
     }
-    assert!(Path::new(&out_dir.join("esplanade/cube-faces_px.exr")).exists());
+    assert!(
+        out_dir
+            .join(probe_names[0])
+            .join("cube-faces_px.exr")
+            .exists()
+    );
     // Irradiance maps: exact and SH9, with SH9's error (a few per cent) and the sun's confidence.
     for p in probes {
         let irr = &p["irradiance"];
@@ -360,7 +426,7 @@ fn demo_writes_every_mapping_and_an_index() {
     // within a few times the reference's own noise).
     assert!(out_dir.join("renders/report.md").exists());
     let renders = summary["renders"].as_array().unwrap();
-    assert_eq!(renders.len(), 2);
+    assert_eq!(renders.len(), scene_count);
     for r in renders {
         for image in r["images"].as_array().unwrap() {
             assert!(out_dir.join(image["preview"].as_str().unwrap()).exists());

@@ -4,12 +4,9 @@
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use ibl_core::rgb::Rgb64;
 use ibl_pipeline::demo::{DemoOptions, demo};
-use ibl_pipeline::demo_paths::{EVAL_DIR, RENDER_DIR};
-use ibl_pipeline::demo_probe::ProbeResult;
+use ibl_pipeline::demo_text::demo_text;
 
-use crate::cmd::eval::print_lights_needed;
 use crate::progress::Bars;
 
 /// Arguments of `ibl demo`.
@@ -62,77 +59,13 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
                 .clone()
                 .unwrap_or_else(|| assets_dir().join("rooms/apartment/room.toml")),
         ),
+        outdoor: Some(assets_dir().join("outdoor/courtyard/scene.toml")),
     };
     let made = demo(
         &options,
         &Bars::default(),
         &[&ibl_viewer::demo_frames::ViewerFrames],
     )?;
-    print_summary(&args.out, &made.probes);
-    println!();
-    print_lights_needed(&made.report);
-    println!(
-        "  {}/{EVAL_DIR}/report.md    the comparison: tables, plots, spheres, overlays",
-        args.out.display()
-    );
-    println!(
-        "  {}/{RENDER_DIR}/report.md the example scenes rendered, lights scored against the reference",
-        args.out.display()
-    );
-    if let Some(room) = &made.room {
-        println!(
-            "  {}/room/report.md        the reconstructed room: {} patches, rho per group, {} important patches",
-            args.out.display(),
-            room.patches,
-            ibl_pipeline::demo_room::DEMO_IMPORTANT_PATCHES
-        );
-    }
-    for s in &made.sections {
-        println!("  {}/index.html#{}  {}", args.out.display(), s.id, s.title);
-    }
+    print!("{}", demo_text(&args.out, &made));
     Ok(())
-}
-
-fn print_summary(out: &Path, results: &[ProbeResult]) {
-    println!(
-        "{:<12} {:>9} {:>8} {:>12}  round-trip power change per mapping (%)",
-        "probe", "size", "stops", "luminance"
-    );
-    for r in results {
-        let i = &r.info;
-        let [pr, pg, pb] = i.power.unwrap_or_default(); // the demo's probes are lat-long
-        let power_lum = Rgb64 {
-            r: pr,
-            g: pg,
-            b: pb,
-        }
-        .luminance();
-        let changes: Vec<String> = r
-            .mappings
-            .iter()
-            .filter_map(|m| {
-                m.round_trip_power_change_pct
-                    .map(|c| format!("{} {c:+.3}", m.mapping))
-            })
-            .collect();
-        println!(
-            "{:<12} {:>9} {:>8.1} {:>12.4e}  {}",
-            r.name,
-            format!("{}x{}", i.width, i.height),
-            i.dynamic_range.stops,
-            power_lum,
-            changes.join(", ")
-        );
-    }
-    println!();
-    println!("outputs in {}/", out.display());
-    println!(
-        "  {}/index.html     every probe in every mapping, tone-mapped",
-        out.display()
-    );
-    println!("  {}/summary.json   the same as data", out.display());
-    println!(
-        "  {}/<probe>/       info.json, latlong.png, <mapping>.exr and .png",
-        out.display()
-    );
 }

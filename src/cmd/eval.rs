@@ -4,8 +4,6 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use ibl_eval::Report;
-use ibl_eval::report::LightsNeeded;
 use ibl_pipeline::eval::{DEFAULT_COUNTS, EvalSettings, evaluate};
 
 use crate::probe_arg::ProbeMappingArgs;
@@ -61,33 +59,6 @@ pub struct EvalArgs {
     pub overlay_n: Option<usize>,
 }
 
-/// Prints, per method, how many lights the averages need for 1 % and 5 % error.
-pub fn print_lights_needed(report: &Report) {
-    let largest = report.counts.iter().copied().max().unwrap_or(0);
-    let k = report.probes.len();
-    println!(
-        "lights needed (smallest N swept), average over {k} probe{}:",
-        if k == 1 { "" } else { "s" }
-    );
-    println!(
-        "  {:<24} {:>9} {:>9} {:>9} {:>9}",
-        "method", "mean<=1%", "mean<=5%", "max<=1%", "max<=5%"
-    );
-    for x in LightsNeeded::average(report) {
-        let [a, b, c, d] = x.cells(largest);
-        println!("  {:<24} {a:>9} {b:>9} {c:>9} {d:>9}", x.method);
-    }
-    let not_ok = report
-        .probes
-        .iter()
-        .flat_map(|p| &p.rows)
-        .filter(|r| r.status != ibl_eval::Status::Ok)
-        .count();
-    if not_ok > 0 {
-        println!("  ({not_ok} runs skipped or failed; see the report)");
-    }
-}
-
 /// Runs `ibl eval`.
 pub fn run(args: &EvalArgs) -> anyhow::Result<()> {
     let mut settings = EvalSettings::new(
@@ -103,7 +74,7 @@ pub fn run(args: &EvalArgs) -> anyhow::Result<()> {
         println!("{}", serde_json::to_string_pretty(&report)?);
         return Ok(());
     }
-    print_lights_needed(&report);
+    print!("{}", ibl_pipeline::demo_text::lights_needed_text(&report));
     let out = args.out.display();
     println!("report in {out}/report.md ({out}/report.json, {out}/report.csv)");
     println!("  plots in {out}/plots/, spheres in {out}/spheres/, overlays in {out}/overlays/");

@@ -8,6 +8,7 @@ pub mod eval;
 pub mod info;
 pub mod irradiance;
 pub mod lights;
+pub mod outdoor;
 pub mod prefilter;
 pub mod preview;
 pub mod render;

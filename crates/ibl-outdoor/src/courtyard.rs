@@ -177,6 +177,26 @@ impl Courtyard {
         }
     }
 
+    /// The virtual object of the validation and the demo: a statue (a 1 m plinth of white stone
+    /// and a 0.6 m sphere of bronze-coloured stone on it, both Lambertian as the paper's model
+    /// assumes) west of the kiosk, 10 m in front of the camera: in the sun until the afternoon,
+    /// when the west block's shadow reaches it (a real shadow on the virtual object), its own
+    /// shadow on the paving the camera sees.
+    pub fn statue() -> GeometryLayer {
+        GeometryLayer::new(vec![
+            placed(
+                "plinth".into(),
+                primitives::cuboid(Vec3::new(-4.45, 0.0, -1.45), Vec3::new(-3.55, 1.0, -0.55)),
+                diffuse(0.72, 0.70, 0.66),
+            ),
+            placed(
+                "sphere".into(),
+                primitives::sphere(Vec3::new(-4.0, 1.6, -1.0), 0.6, 3),
+                diffuse(0.55, 0.36, 0.20),
+            ),
+        ])
+    }
+
     /// The mask of marked diffuse surfaces for `frame_size` frames: every pixel that sees the
     /// model (everything in the synthetic yard is diffuse).
     pub fn diffuse_mask(&self, frame_size: (usize, usize)) -> Image<bool> {

@@ -22,6 +22,8 @@
 //! - [`volume_refresh`]: the irradiance volume from the relit map (a) or from key-point
 //!   responses (b).
 //! - [`system`]: the whole per-frame loop behind one type.
+//! - [`composite`]: each frame's virtual objects, rendered under the estimates and composited
+//!   into the frame by differential rendering (shadows both ways).
 //! - [`courtyard`] and [`synthetic`]: the validation scene and its path-traced day.
 //! - [`plot`]: the estimates over a day as an SVG chart.
 //!
@@ -29,6 +31,7 @@
 //! surface facing the sun), `P_a` the radiance of the uniform sky of the same horizontal
 //! irradiance (docs/CONVENTIONS.md, "Sun, sky and time"). This crate does no I/O.
 
+pub mod composite;
 pub mod courtyard;
 pub mod estimate;
 pub mod footprint;
@@ -48,6 +51,7 @@ pub mod transfer;
 pub mod view;
 pub mod volume_refresh;
 
+pub use composite::{CompositeSettings, FrameCompositor, FrameLighting};
 pub use estimate::{Estimate, EstimatorOptions, Observation, estimate};
 pub use interreflection::Interreflection;
 pub use maps::{CaptureSource, LightingParameters, MapSettings, ProbeMaps};

@@ -27,7 +27,7 @@ use std::f64::consts::PI;
 
 use glam::{DVec3, Mat3, Vec3};
 use ibl_core::{Image, LatLong, Rgb};
-use ibl_render::{Lighting, RenderSettings, render};
+use ibl_render::{Lighting, RenderOutput, RenderSettings, render};
 use ibl_scene::description::{CompositeRule, LightingDescription, RenderDescription, SamplerKind};
 use ibl_scene::{Background, Camera, GeometryLayer, Probe, Scene};
 use serde::Serialize;
@@ -219,13 +219,14 @@ impl SyntheticDay {
     fn scene(
         &self,
         layer: &GeometryLayer,
+        objects: &GeometryLayer,
         environment: Image<Rgb>,
         camera: Camera,
         probe: Vec3,
     ) -> Scene {
         Scene {
             real: layer.clone(),
-            virtual_objects: GeometryLayer::empty(),
+            virtual_objects: objects.clone(),
             probe: Probe {
                 radiance: environment,
                 world_from_probe: Mat3::IDENTITY,
@@ -264,6 +265,7 @@ impl SyntheticDay {
         };
         let scene = self.scene(
             &yard.layer,
+            &GeometryLayer::empty(),
             self.environment(truth)?,
             camera,
             yard.probe_position,
@@ -285,20 +287,37 @@ impl SyntheticDay {
         truth: &TrueLighting,
         seed: u64,
     ) -> Result<Image<Rgb>, OutdoorError> {
+        let out =
+            self.render_frame_with(yard, &GeometryLayer::empty(), truth, self.frame_spp, seed)?;
+        Ok(out.with_objects)
+    }
+
+    /// The path-traced frame of the yard's camera under `truth` with virtual `objects` standing
+    /// in the yard, at `spp` samples per pixel: `with_objects` is the truth of a composite,
+    /// `without_objects` the real frame (the same paths wherever the objects change nothing, so
+    /// the two differ only where the objects matter).
+    pub fn render_frame_with(
+        &self,
+        yard: &Courtyard,
+        objects: &GeometryLayer,
+        truth: &TrueLighting,
+        spp: u32,
+        seed: u64,
+    ) -> Result<RenderOutput, OutdoorError> {
         let scene = self.scene(
             &yard.layer,
+            objects,
             self.environment(truth)?,
             yard.camera,
             yard.probe_position,
         );
         let lighting = Lighting::reference(&scene).map_err(ibl_render::RenderError::from)?;
-        let out = render(
+        Ok(render(
             &scene,
             &lighting,
-            &self.settings(self.frame_size.0, self.frame_spp, seed),
+            &self.settings(self.frame_size.0, spp, seed),
             &|_, _| {},
-        )?;
-        Ok(out.with_objects)
+        )?)
     }
 }
 

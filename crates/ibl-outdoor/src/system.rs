@@ -18,6 +18,7 @@ use ibl_sh::{IrradianceVolume, VolumeGrid};
 use serde::Serialize;
 
 use crate::OutdoorError;
+use crate::composite::FrameLighting;
 use crate::estimate::{Estimate, EstimatorOptions, estimate};
 use crate::maps::{CaptureSource, MapSettings, ProbeMaps};
 use crate::relight::{Relighter, SunLight};
@@ -278,6 +279,17 @@ impl OutdoorSystem {
     /// The relit map of the last frame (probe frame, lat-long).
     pub fn relit_map(&self) -> &Image<Rgb> {
         &self.relit
+    }
+
+    /// The lighting `result` (this system's last frame) gives a composite: its sun, the sky shape
+    /// and `P_a` it was estimated with, and the relit map.
+    pub fn frame_lighting(&self, result: &FrameResult) -> Result<FrameLighting<'_>, OutdoorError> {
+        Ok(FrameLighting {
+            sun: result.sun,
+            sky_shape: self.sky.shape()?,
+            sky: result.estimate.sky_rgb(),
+            relit_map: &self.relit,
+        })
     }
 
     /// The volume after the last frame.

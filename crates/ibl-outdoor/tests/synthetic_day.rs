@@ -15,12 +15,17 @@
 //! renders of the truth with different seeds, is 1.25 % (checked below the figure).
 
 use glam::Vec3;
+use ibl_core::Image;
+use ibl_metrics::ImageDifference;
 use ibl_outdoor::courtyard::Courtyard;
 use ibl_outdoor::synthetic::{SyntheticDay, Weather, map_error};
 use ibl_outdoor::{
-    CameraSetup, CaptureSource, Interreflection, MapSettings, OutdoorSystem, ProbeCapture,
-    SampleSettings, SkyModel, SystemSettings, VolumeRefresh, VolumeSettings,
+    CameraSetup, CaptureSource, CompositeSettings, FrameCompositor, Interreflection, MapSettings,
+    OutdoorSystem, ProbeCapture, SampleSettings, SkyModel, SystemSettings, VolumeRefresh,
+    VolumeSettings,
 };
+use ibl_render::RenderOutput;
+use ibl_scene::description::CompositeRule;
 use ibl_sh::{LeakControl, VolumeGrid, VolumeLayer};
 
 #[test]
@@ -58,6 +63,26 @@ fn the_synthetic_day_meets_the_papers_figures() {
         },
         ..SystemSettings::default()
     };
+    let statue = Courtyard::statue();
+    let compositor = |rule| {
+        FrameCompositor::new(
+            yard.layer.clone(),
+            statue.clone(),
+            yard.camera,
+            yard.probe_position,
+            glam::Mat3::IDENTITY,
+            CompositeSettings {
+                spp: 64,
+                rule,
+                ..CompositeSettings::default()
+            },
+        )
+        .unwrap()
+    };
+    let (ratio, difference) = (
+        compositor(CompositeRule::Ratio),
+        compositor(CompositeRule::Difference),
+    );
     let mut system = OutdoorSystem::new(
         yard.layer.clone(),
         day.location,
@@ -132,8 +157,14 @@ fn the_synthetic_day_meets_the_papers_figures() {
     let frames: Vec<usize> = vec![0, 3, 6, 10, 13, 15];
     for k in frames {
         let truth = day.frame_truth(k).unwrap();
-        let frame = day.render_frame(&yard, &truth, 100 + k as u64).unwrap();
-        let result = system.process(day.frame_time(k), &frame).unwrap();
+        // The frame with the virtual statue standing in the yard: `without_objects` is the real
+        // frame the estimation reads, `with_objects` the truth of the composite (the same paths
+        // wherever the statue changes nothing).
+        let rendered = day
+            .render_frame_with(&yard, &statue, &truth, day.frame_spp, 100 + k as u64)
+            .unwrap();
+        let frame = &rendered.without_objects;
+        let result = system.process(day.frame_time(k), frame).unwrap();
         let e = result.estimate;
         let t = truth.parameters;
         let sun_err: Vec<f32> = (0..3)
@@ -227,6 +258,42 @@ fn the_synthetic_day_meets_the_papers_figures() {
                 exact - sun_part
             );
             assert!((e_up / (exact - sun_part) - 1.0).abs() < 0.15);
+            // The statue composited under the estimates against the path-traced frame with it.
+            let twin = (k == 6).then(|| {
+                day.render_frame_with(&yard, &statue, &truth, day.frame_spp, 900 + k as u64)
+                    .unwrap()
+            });
+            let lighting = system.frame_lighting(&result).unwrap();
+            for (name, compositor) in [("ratio", &ratio), ("difference", &difference)] {
+                let out = compositor.composite(frame, &lighting).unwrap();
+                let figure = composite_error(&out, &rendered, twin.as_ref());
+                println!(
+                    "       composite ({name}) vs path-traced frame with the statue: relative MSE {:.3} % over {} pixels where it matters{}, {:.4} % over the frame",
+                    100.0 * figure.region,
+                    figure.pixels,
+                    figure
+                        .floor
+                        .map_or(String::new(), |f| format!(" (floor {:.3} %)", 100.0 * f)),
+                    100.0 * figure.whole
+                );
+                assert!(
+                    figure.pixels > 200,
+                    "frame {k}: the statue touches {} pixels",
+                    figure.pixels
+                );
+                // The figure: relative MSE <= 3 %, taken where the statue matters (the
+                // stricter reading; over the whole frame it is 30 to 100 times smaller).
+                assert!(
+                    figure.region <= 0.03,
+                    "frame {k}, {name}: {}",
+                    figure.region
+                );
+                if let Some(floor) = figure.floor {
+                    // The truth's own noise (two seeds) is of the figure's order: the figure
+                    // sees the composite, not only the truth's noise.
+                    assert!(floor < 4.0 * figure.region.max(1e-4), "floor {floor}");
+                }
+            }
         }
     }
     println!(
@@ -235,4 +302,45 @@ fn the_synthetic_day_meets_the_papers_figures() {
     // The figures: 3 % per channel on clear frames, P_d <= 5 % of clear when overcast.
     assert!(worst_clear <= 3.0, "clear frames: {worst_clear} %");
     assert!(worst_overcast <= 5.0, "overcast: {worst_overcast} %");
+}
+
+/// The composite's figure against the path-traced frame with the statue.
+struct CompositeFigure {
+    /// Relative MSE where the statue matters: its pixels and where the composite changed the
+    /// frame by more than 1 % (its shadows, its occlusion of the sky).
+    region: f64,
+    /// Pixels of that region.
+    pixels: usize,
+    /// Relative MSE over the whole frame.
+    whole: f64,
+    /// The same region's figure between two truths of different seeds (their noise).
+    floor: Option<f64>,
+}
+
+#[allow(clippy::unwrap_used)] // a test's helper: a failure is the test's
+fn composite_error(
+    out: &RenderOutput,
+    truth: &RenderOutput,
+    twin: Option<&RenderOutput>,
+) -> CompositeFigure {
+    let frame = &truth.without_objects;
+    let region = Image::from_fn_par(frame.width(), frame.height(), |i, j| {
+        let (a, b) = (out.composite.get(i, j), frame.get(i, j));
+        *out.object_coverage.get(i, j) > 0.0 || (0..3).any(|c| (a[c] - b[c]).abs() > 0.01 * b[c])
+    });
+    let pixels = region.pixels().iter().filter(|&&r| r).count();
+    let local =
+        ImageDifference::between(&out.composite, &truth.with_objects, Some(&region)).unwrap();
+    let whole = ImageDifference::between(&out.composite, &truth.with_objects, None).unwrap();
+    let floor = twin.map(|t| {
+        ImageDifference::between(&t.with_objects, &truth.with_objects, Some(&region))
+            .unwrap()
+            .relative_mse
+    });
+    CompositeFigure {
+        region: local.relative_mse,
+        pixels,
+        whole: whole.relative_mse,
+        floor,
+    }
 }

@@ -8,14 +8,17 @@
 //! (every extraction method, SH9 alone and LightGen lights with an SH9 ambient, N = 1 to 128,
 //! 20000 scoring normals) into `eval/`, and renders the example scenes (`renders/`,
 //! [`crate::demo_render`]) and estimates the worked example's room (Grosch 2005: reflectance per
-//! group, the report, the important patches; `room/`, [`crate::demo_room`]). Everything lands in one folder with an `index.html` to look at and a
-//! `summary.json` for scripts ([`crate::demo_page`]).
+//! group, the report, the important patches; `room/`, [`crate::demo_room`]) and runs the bundled
+//! outdoor sequence (Jensen et al. 2006: sun and sky per frame, composites; `outdoor/`,
+//! [`crate::demo_outdoor`]). Everything lands in one folder with an `index.html` to look at and
+//! a `summary.json` for scripts ([`crate::demo_page`]).
 
 use std::path::{Path, PathBuf};
 
 use ibl_extract::ModelSpec;
 use ibl_light::{LightSource, Method};
 
+use crate::demo_outdoor::demo_outdoor;
 use crate::demo_paths::EVAL_DIR;
 use crate::demo_probe::{ProbeResult, demo_mappings, demo_probe};
 use crate::demo_render::{SceneResult, demo_renders};
@@ -37,6 +40,9 @@ pub struct DemoOptions {
     /// Room file of the room section (the bundled `assets/rooms/apartment/room.toml`); none
     /// leaves the section out.
     pub room: Option<PathBuf>,
+    /// Scene file of the outdoor section (the bundled `assets/outdoor/courtyard/scene.toml`);
+    /// none leaves the section out.
+    pub outdoor: Option<PathBuf>,
 }
 
 /// What the demo made.
@@ -99,7 +105,7 @@ pub fn list_probes(dir: &Path) -> Result<Vec<PathBuf>> {
 }
 
 /// Runs the demo (see the module doc); each of `front_ends` adds a section to the page after the
-/// renders and the room.
+/// renders, the room and the outdoor sequence.
 pub fn demo(
     o: &DemoOptions,
     progress: &dyn Progress,
@@ -148,10 +154,15 @@ pub fn demo(
         Some(path) => Some(demo_room(path, &o.out, progress)?),
         None => None,
     };
-    let sections: Vec<PageSection> = front_ends
-        .iter()
-        .map(|f| f.section(&o.scenes, &o.out, progress))
-        .collect();
+    let mut sections: Vec<PageSection> = Vec::new();
+    if let Some(scene) = &o.outdoor {
+        sections.push(demo_outdoor(scene, &o.out, progress)?);
+    }
+    sections.extend(
+        front_ends
+            .iter()
+            .map(|f| f.section(&o.scenes, &o.out, progress)),
+    );
     crate::demo_page::write_summary(
         &o.out,
         &results,

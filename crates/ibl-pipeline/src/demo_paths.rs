@@ -13,6 +13,9 @@ pub const RENDER_DIR: &str = "renders";
 /// Sub-folder of the reconstructed room.
 pub const ROOM_DIR: &str = "room";
 
+/// Sub-folder of the outdoor sequence.
+pub const OUTDOOR_DIR: &str = "outdoor";
+
 /// `p` relative to `base` (for links in `index.html`).
 pub fn relative(base: &Path, p: &Path) -> String {
     p.strip_prefix(base).unwrap_or(p).display().to_string()

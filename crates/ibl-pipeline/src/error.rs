@@ -10,6 +10,7 @@ use ibl_extract::ExtractError;
 use ibl_io::IoError;
 use ibl_mapping::MappingError;
 use ibl_metrics::DifferenceError;
+use ibl_outdoor::OutdoorError;
 use ibl_render::RenderError;
 use ibl_room::RoomError;
 use ibl_scene::DescriptionError;
@@ -54,6 +55,9 @@ pub enum PipelineError {
     /// A room, marks file or room estimate (Grosch 2005).
     #[error(transparent)]
     Room(#[from] RoomError),
+    /// The outdoor pipeline (Jensen, Andersen & Madsen 2006).
+    #[error(transparent)]
+    Outdoor(#[from] OutdoorError),
     /// An option the caller gave is out of range or contradicts another (the message says which
     /// and why): always the input's fault.
     #[error("{0}")]
@@ -84,6 +88,7 @@ impl PipelineError {
             PipelineError::Difference(e) => e.is_bad_input(),
             PipelineError::Description(e) => e.is_bad_input(),
             PipelineError::Room(e) => e.is_bad_input(),
+            PipelineError::Outdoor(e) => e.is_bad_input(),
             PipelineError::Parameter(_) => true,
             PipelineError::Context { source, .. } => source.is_bad_input(),
         }

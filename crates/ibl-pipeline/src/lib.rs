@@ -18,10 +18,13 @@
 //! - [`room_calibrate`], [`room_estimate`], [`room_lights`]: the reconstructed room of Grosch
 //!   2005 (marks to frame and scale, room and probe to reflectance and the report, the important
 //!   patches as an area-light file), on [`room_input`];
+//! - [`outdoor`]: outdoor AR under changing light (Jensen, Andersen & Madsen 2006): per-frame
+//!   sun and sky estimates, relit maps and composites of a frame sequence;
 //! - [`capture`]: brackets merged to HDR ([`exposure_list`]: the time files it reads);
 //!   [`capture_views`]: mirror balls and fisheye pairs;
 //! - [`demo`]: the main job on the bundled probes and scenes ([`demo_probe`], [`demo_render`],
-//!   [`demo_page`], [`demo_paths`], [`demo_room`]).
+//!   [`demo_page`], [`demo_paths`], [`demo_room`], [`demo_outdoor`]; [`demo_text`]: what the
+//!   command line prints after the demo and the comparison).
 //!
 //! Every output path is checked before the work starts ([`output_paths`]).
 //!
@@ -33,12 +36,14 @@ pub mod capture_views;
 pub mod compare;
 pub mod convert;
 pub mod demo;
+pub mod demo_outdoor;
 pub mod demo_page;
 pub mod demo_paths;
 pub mod demo_probe;
 pub mod demo_render;
 pub mod demo_room;
 pub mod demo_section;
+pub mod demo_text;
 pub mod envmap_files;
 pub mod error;
 pub mod eval;
@@ -47,6 +52,7 @@ pub mod info;
 pub mod irradiance;
 pub mod lighting_plan;
 pub mod lights;
+pub mod outdoor;
 pub mod output_paths;
 pub mod prefilter;
 pub mod preview;

@@ -486,3 +486,296 @@ fn mutated_scenes_never_panic() {
     // Most mutations break the file, some (inside comments) do not.
     assert!(outcomes[0] > 0 && outcomes[1] > 0, "{outcomes:?}");
 }
+
+/// An outdoor scene (`[outdoor]`, Jensen, Andersen & Madsen 2006): the probe taken once, the
+/// model of the courtyard, the video camera, a representative frame and the whole table.
+const OUTDOOR: &str = r#"version = 1
+
+[probe]
+file = "probe.exr"
+position = [0.0, 1.5, 0.0]
+
+[background]
+kind = "photo"
+file = "frames/0000.png"
+
+[camera]
+position = [0.0, 1.6, 4.0]
+look_at = [0.0, 0.5, 0.0]
+vertical_fov_deg = 50.0
+
+[[local]]
+name = "ground"
+shape = "plane"
+size = [40.0, 40.0]
+
+[[object]]
+shape = "sphere"
+radius = 0.5
+
+[outdoor]
+latitude_deg = 57.048
+longitude_deg = 9.921
+elevation_m = 5.0
+utc_offset_hours = 2.0
+north = [1.0, 0.0, -1.0]
+pressure_mbar = 1000.0
+temperature_c = 9.5
+probe_time = 2024-04-20T09:30:00
+mask = "mask.png"
+samples = 800
+smoothing = true
+volume_spacing_m = 2.0
+
+[outdoor.frames]
+source = "frames"
+start = 2024-04-20T11:00:00.5
+interval_s = 1800.0
+"#;
+
+#[test]
+fn a_full_outdoor_table_parses() {
+    let d = SceneDescription::from_toml(OUTDOOR).unwrap();
+    let o = d.outdoor.as_ref().unwrap();
+    assert_eq!((o.latitude_deg, o.longitude_deg), (57.048, 9.921));
+    assert_eq!((o.elevation_m, o.utc_offset_hours), (5.0, 2.0));
+    assert_eq!((o.pressure_mbar, o.temperature_c), (1000.0, 9.5));
+    assert_eq!(o.north, [1.0, 0.0, -1.0]);
+    let n = o.north_unit();
+    let h = std::f32::consts::FRAC_1_SQRT_2;
+    assert!((n - Vec3::new(h, 0.0, -h)).length() < 1e-6, "{n}");
+    assert_eq!(o.probe_local_time().unwrap(), (2024, 4, 20, 9, 30, 0.0));
+    assert_eq!(o.mask, PathBuf::from("mask.png"));
+    assert_eq!(
+        (o.samples, o.smoothing, o.volume_spacing_m),
+        (800, true, Some(2.0))
+    );
+    assert_eq!(o.frames.source, PathBuf::from("frames"));
+    assert_eq!(
+        o.frames.start_local_time().unwrap(),
+        (2024, 4, 20, 11, 0, 0.5)
+    );
+    assert_eq!(o.frames.interval_s, 1800.0);
+    // The rest is an ordinary scene.
+    assert_eq!(d.local.len(), 1);
+    assert!(d.camera.is_some());
+    // A scene without the table has none.
+    assert!(SceneDescription::from_toml(BASE).unwrap().outdoor.is_none());
+}
+
+#[test]
+fn outdoor_defaults_fill_what_is_left_out() {
+    let mut text = OUTDOOR.to_string();
+    for line in [
+        "elevation_m = 5.0\n",
+        "north = [1.0, 0.0, -1.0]\n",
+        "pressure_mbar = 1000.0\n",
+        "temperature_c = 9.5\n",
+        "samples = 800\n",
+        "smoothing = true\n",
+        "volume_spacing_m = 2.0\n",
+    ] {
+        text = text.replace(line, "");
+    }
+    let d = SceneDescription::from_toml(&text).unwrap();
+    let o = d.outdoor.unwrap();
+    assert_eq!(o.elevation_m, 0.0);
+    assert_eq!(o.north, ibl_scene::description::DEFAULT_NORTH);
+    assert_eq!(o.north_unit(), Vec3::NEG_Z);
+    assert_eq!((o.pressure_mbar, o.temperature_c), (1013.25, 12.0));
+    assert_eq!(
+        (o.samples, o.smoothing, o.volume_spacing_m),
+        (500, false, None)
+    );
+}
+
+#[test]
+fn every_outdoor_rule_names_its_field() {
+    let bad = |from: &str, to: &str, field: &str, phrase: &str| {
+        assert!(OUTDOOR.contains(from), "{from}");
+        refused(&OUTDOOR.replacen(from, to, 1), field, phrase);
+    };
+    bad(
+        "latitude_deg = 57.048",
+        "latitude_deg = 91.0",
+        "outdoor.latitude_deg",
+        "[-90, 90]",
+    );
+    bad(
+        "longitude_deg = 9.921",
+        "longitude_deg = -180.5",
+        "outdoor.longitude_deg",
+        "[-180, 180]",
+    );
+    bad(
+        "elevation_m = 5.0",
+        "elevation_m = nan",
+        "outdoor.elevation_m",
+        "not in",
+    );
+    bad(
+        "utc_offset_hours = 2.0",
+        "utc_offset_hours = 15.0",
+        "outdoor.utc_offset_hours",
+        "[-14, 14]",
+    );
+    for north in ["[0.0, 0.0, 0.0]", "[0.0, 1.0, -1.0]", "[inf, 0.0, -1.0]"] {
+        bad(
+            "north = [1.0, 0.0, -1.0]",
+            &format!("north = {north}"),
+            "outdoor.north",
+            "",
+        );
+    }
+    bad(
+        "north = [1.0, 0.0, -1.0]",
+        "north = [0.0, 0.1, -1.0]",
+        "outdoor.north",
+        "off the horizontal",
+    );
+    bad(
+        "north = [1.0, 0.0, -1.0]",
+        "north = [0.0, 0.0, 0.0]",
+        "outdoor.north",
+        "zero",
+    );
+    bad(
+        "pressure_mbar = 1000.0",
+        "pressure_mbar = 0.0",
+        "outdoor.pressure_mbar",
+        "(0, 2000]",
+    );
+    bad(
+        "temperature_c = 9.5",
+        "temperature_c = 61.0",
+        "outdoor.temperature_c",
+        "[-90, 60]",
+    );
+    bad(
+        "probe_time = 2024-04-20T09:30:00",
+        "probe_time = 2024-04-20T09:30:00+02:00",
+        "outdoor.probe_time",
+        "UTC offset",
+    );
+    bad(
+        "probe_time = 2024-04-20T09:30:00",
+        "probe_time = 2024-04-20",
+        "outdoor.probe_time",
+        "not a date and a time",
+    );
+    bad(
+        "probe_time = 2024-04-20T09:30:00",
+        "probe_time = \"2024-04-20T09:30:00\"",
+        "outdoor.probe_time",
+        "datetime",
+    );
+    bad(
+        "mask = \"mask.png\"",
+        "mask = \"\"",
+        "outdoor.mask",
+        "empty",
+    );
+    bad(
+        "samples = 800",
+        "samples = 0",
+        "outdoor.samples",
+        "1..=100000",
+    );
+    bad(
+        "samples = 800",
+        "samples = 100001",
+        "outdoor.samples",
+        "1..=100000",
+    );
+    bad(
+        "volume_spacing_m = 2.0",
+        "volume_spacing_m = -1.0",
+        "outdoor.volume_spacing_m",
+        "positive",
+    );
+    bad(
+        "start = 2024-04-20T11:00:00.5",
+        "start = 2024-04-20T11:00:00Z",
+        "outdoor.frames.start",
+        "UTC offset",
+    );
+    bad(
+        "interval_s = 1800.0",
+        "interval_s = 0.0",
+        "outdoor.frames.interval_s",
+        "positive",
+    );
+    bad(
+        "interval_s = 1800.0",
+        "interval_s = inf",
+        "outdoor.frames.interval_s",
+        "positive",
+    );
+    bad(
+        "source = \"frames\"",
+        "source = \"\"",
+        "outdoor.frames.source",
+        "empty",
+    );
+    // Unknown and missing fields, in either table.
+    bad(
+        "samples = 800",
+        "samples = 800\nfoo = 1",
+        "outdoor.foo",
+        "unknown field `foo`",
+    );
+    refused(
+        &format!("{OUTDOOR}fps = 25\n"),
+        "outdoor.frames.fps",
+        "unknown field `fps`",
+    );
+    bad(
+        "latitude_deg = 57.048\n",
+        "",
+        "outdoor.latitude_deg",
+        "missing field",
+    );
+    bad(
+        "interval_s = 1800.0\n",
+        "",
+        "outdoor.frames.interval_s",
+        "missing field",
+    );
+}
+
+#[test]
+fn an_outdoor_scene_needs_a_camera_and_a_photo_background() {
+    let start = OUTDOOR.find("[camera]").unwrap();
+    let end = OUTDOOR.find("[[local]]").unwrap();
+    let no_camera = format!("{}{}", &OUTDOOR[..start], &OUTDOOR[end..]);
+    refused(&no_camera, "camera", "[outdoor]");
+    // A panorama background (no file) with the camera: refused at the background's kind.
+    let panorama = OUTDOOR
+        .replace("kind = \"photo\"\n", "")
+        .replace("file = \"frames/0000.png\"\n", "");
+    refused(&panorama, "background.kind", "photo");
+    // Built in code: the same checks, and the table's own.
+    let mut d = SceneDescription::from_toml(OUTDOOR).unwrap();
+    d.camera = None;
+    assert_eq!(d.validate().unwrap_err().field, "camera");
+    let mut d = SceneDescription::from_toml(OUTDOOR).unwrap();
+    d.outdoor.as_mut().unwrap().frames.interval_s = 0.0;
+    assert_eq!(d.validate().unwrap_err().field, "outdoor.frames.interval_s");
+}
+
+#[test]
+fn the_outdoor_example_in_the_user_documentation_parses() {
+    let doc = std::fs::read_to_string(
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../docs/SCENES.md"),
+    )
+    .unwrap();
+    let section = doc.find("## `[outdoor]`").unwrap();
+    let start = section + doc[section..].find("```toml\n").unwrap() + "```toml\n".len();
+    let end = start + doc[start..].find("```").unwrap();
+    let d = SceneDescription::from_toml(&doc[start..end]).unwrap();
+    let o = d.outdoor.unwrap();
+    assert_eq!(
+        o.frames.start_local_time().unwrap(),
+        (2024, 4, 20, 11, 0, 0.0)
+    );
+}

@@ -81,6 +81,10 @@ pub fn rebased(description: &SceneDescription, from: &Path, to: &Path) -> SceneD
             fix(p);
         }
     }
+    if let Some(outdoor) = &mut d.outdoor {
+        fix(&mut outdoor.mask);
+        fix(&mut outdoor.frames.source);
+    }
     d
 }
 
@@ -147,5 +151,21 @@ mod tests {
             rebase(Path::new("/abs/p.exr"), &a, &b),
             PathBuf::from("/abs/p.exr")
         );
+    }
+
+    #[test]
+    fn an_outdoor_scene_keeps_its_mask_and_frames_when_saved_elsewhere() {
+        let text = std::fs::read_to_string(
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/outdoor/courtyard/scene.toml"),
+        )
+        .expect("the bundled outdoor scene");
+        let d = SceneDescription::from_toml(&text).expect("parses");
+        let dir = tempfile::tempdir().expect("temp dir");
+        let (from, to) = (dir.path().join("a"), dir.path().join("b").join("c"));
+        std::fs::create_dir_all(&to).expect("mkdir");
+        let r = rebased(&d, &from, &to);
+        let outdoor = r.outdoor.expect("the [outdoor] table");
+        assert_eq!(outdoor.mask, PathBuf::from("../../a/mask.png"));
+        assert_eq!(outdoor.frames.source, PathBuf::from("../../a/frames"));
     }
 }

@@ -7,11 +7,13 @@
 //! (`[[local]]`: planes, boxes, spheres and meshes with a diffuse albedo per material group: the real
 //! surfaces near the virtual objects, Debevec 1998's "local scene"), **virtual objects**
 //! (`[[object]]`: meshes or shapes with a transform and a material), the renderer's settings
-//! (`[render]`) and the lighting (`[lighting]`).
+//! (`[render]`), the lighting (`[lighting]`) and, for outdoor AR under changing light (Jensen,
+//! Andersen & Madsen 2006), the site, times, mask and video frames (`[outdoor]`).
 //!
 //! One module per table of the file ([`ProbeDescription`] in `probe`, `background`, `camera`,
-//! `geometry` for `[[local]]` and `[[object]]`, `material`, `render`, `lighting`); this module holds
-//! the whole file and the checks that span tables (a photo background needs a camera, ...).
+//! `geometry` for `[[local]]` and `[[object]]`, `material`, `render`, `lighting`, `outdoor`); this
+//! module holds the whole file and the checks that span tables (a photo background needs a camera,
+//! an outdoor scene a camera and a photo background, ...).
 //!
 //! Parsing refuses unknown fields (a typo is an error, not a silently ignored setting). After
 //! parsing, [`SceneDescription::validate`] checks every value and names the offending field by its
@@ -24,6 +26,7 @@ mod field;
 mod geometry;
 mod lighting;
 mod material;
+mod outdoor;
 mod probe;
 mod render;
 mod toml_error;
@@ -40,6 +43,10 @@ pub use lighting::{LightingDescription, ShadowKind};
 pub use material::{
     DEFAULT_ALBEDO, DEFAULT_EXPONENT, DEFAULT_MIRROR, DEFAULT_SPECULAR, MaterialDescription,
     MaterialKind,
+};
+pub use outdoor::{
+    CivilTime, DEFAULT_NORTH, DEFAULT_PRESSURE_MBAR, DEFAULT_SAMPLES, DEFAULT_TEMPERATURE_C,
+    FramesDescription, MAX_NORTH_TILT_DEG, MAX_SAMPLES, OutdoorDescription, local_civil_time,
 };
 pub use probe::ProbeDescription;
 pub use render::{
@@ -75,6 +82,11 @@ pub struct SceneDescription {
     /// Lighting approximation for the `lights` and `hybrid` modes.
     #[serde(default)]
     pub lighting: LightingDescription,
+    /// Outdoor AR under changing light (sun and sky estimated per video frame): the site, the
+    /// probe's time, the estimation's mask and the frames. Default none: an indoor or still
+    /// scene. With it, `camera` is the video camera and `background` a representative frame.
+    #[serde(default)]
+    pub outdoor: Option<OutdoorDescription>,
 }
 
 impl SceneDescription {
@@ -103,6 +115,20 @@ impl SceneDescription {
             ));
         }
         self.probe.validate()?;
+        if self.outdoor.is_some() {
+            if self.camera.is_none() {
+                return Err(invalid(
+                    "camera",
+                    "an [outdoor] scene needs the calibrated video camera as its [camera]",
+                ));
+            }
+            if self.background.kind != BackgroundKind::Photo {
+                return Err(invalid(
+                    "background.kind",
+                    "an [outdoor] scene's background is a representative frame: give `kind = \"photo\"` and its file",
+                ));
+            }
+        }
         match self.background.kind {
             BackgroundKind::Panorama => {
                 if self.background.file.is_some() {
@@ -159,6 +185,9 @@ impl SceneDescription {
         }
         self.render.validate()?;
         self.lighting.validate()?;
+        if let Some(outdoor) = &self.outdoor {
+            outdoor.validate()?;
+        }
         Ok(())
     }
 }

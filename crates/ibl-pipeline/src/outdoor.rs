@@ -1,0 +1,514 @@
+//! The outdoor AR job (`ibl outdoor`; Jensen, Andersen & Madsen 2006, `ibl-outdoor`): a scene
+//! file with an `[outdoor]` table (docs/SCENES.md) and its folder of video frames give, per
+//! frame, the estimated sun and sky (`P_d`, `P_a`), the relit environment map, and the virtual
+//! objects composited into the frame with shadows both ways.
+//!
+//! Outputs, in the output folder: `estimates.csv` (one row per frame), `estimates.json` (the
+//! whole [`OutdoorSummary`]), `estimates.svg` (the chart of `P_d` and `P_a` over the local time),
+//! `composites/NAME.exr` and `.png` per frame (the scene's `[[object]]`s composited; the PNGs share
+//! one exposure, the first frame's, so the light's changes show), and on request
+//! `relit/NAME.exr` (the relit map, probe frame, the sun left out).
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use glam::Vec3;
+use ibl_core::Image;
+use ibl_core::tonemap::{Display, auto_exposure_stops};
+use ibl_io::WriteOptions;
+use ibl_outdoor::plot::{SeriesPoint, estimates_svg};
+use ibl_outdoor::{
+    Atmosphere, CameraSetup, CaptureSource, CompositeSettings, FrameCompositor, FrameResult,
+    Location, OutdoorSystem, ProbeCapture, SampleSettings, SmoothingOptions, SystemSettings,
+    Timestamp, VolumeRefresh, VolumeSettings,
+};
+use ibl_scene::description::{CivilTime, OutdoorDescription};
+use ibl_sh::VolumeGrid;
+use serde::Serialize;
+
+use crate::error::{Context, PipelineError, Result};
+use crate::output_paths::check_output_folder;
+use crate::progress::Progress;
+
+/// Frame file extensions read from the frames folder (case-insensitive).
+pub const FRAME_EXTENSIONS: [&str; 6] = ["exr", "hdr", "pfm", "png", "jpg", "jpeg"];
+/// Most frames one run reads (a day at one frame per second is 86 400).
+pub const MAX_FRAMES: usize = 100_000;
+/// Width and height of the estimates' chart, pixels.
+const CHART_SIZE: (u32, u32) = (900, 620);
+/// Key-point directions of the irradiance volume (width of each point's lat-long).
+const VOLUME_DIRECTIONS: usize = 32;
+/// Margin of the volume's box around the objects, metres.
+const VOLUME_MARGIN_M: f64 = 1.0;
+
+/// What `ibl outdoor` is asked to do.
+#[derive(Clone, Debug, PartialEq)]
+pub struct OutdoorJob {
+    /// The scene file (with an `[outdoor]` table).
+    pub scene: PathBuf,
+    /// The output folder (created when missing).
+    pub out_dir: PathBuf,
+    /// Composite the scene's objects into each frame.
+    pub composites: bool,
+    /// Write each frame's relit map.
+    pub relit_maps: bool,
+    /// The composite's render settings.
+    pub composite: CompositeSettings,
+    /// Process at most this many frames (from the first).
+    pub max_frames: Option<usize>,
+}
+
+impl OutdoorJob {
+    /// The job with the default settings: composites on, relit maps off.
+    pub fn new(scene: PathBuf, out_dir: PathBuf) -> OutdoorJob {
+        OutdoorJob {
+            scene,
+            out_dir,
+            composites: true,
+            relit_maps: false,
+            composite: CompositeSettings::default(),
+            max_frames: None,
+        }
+    }
+}
+
+/// One frame of the run.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct OutdoorFrame {
+    /// Index in the sequence.
+    pub index: usize,
+    /// The frame file.
+    pub file: PathBuf,
+    /// Local time `YYYY-MM-DDTHH:MM:SS`.
+    pub local_time: String,
+    /// Local time of day, hours.
+    pub hour: f64,
+    /// The sun's elevation, degrees.
+    pub sun_elevation_deg: f64,
+    /// What the system estimated (raw and used estimate, sun light, sky condition).
+    pub result: FrameResult,
+    /// The composite (EXR), relative to the output folder.
+    pub composite: Option<PathBuf>,
+    /// The relit map (EXR), relative to the output folder.
+    pub relit_map: Option<PathBuf>,
+    /// Seconds the estimation, relighting and volume refresh took.
+    pub estimate_seconds: f64,
+    /// Seconds the composite took.
+    pub composite_seconds: f64,
+}
+
+/// What the run did.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct OutdoorSummary {
+    /// The scene file.
+    pub scene: PathBuf,
+    /// Frames read, in order.
+    pub frames: Vec<OutdoorFrame>,
+    /// Seconds of the offline step (maps, sample sites, volume weights).
+    pub setup_seconds: f64,
+    /// Sample sites drawn on the marked surfaces.
+    pub sample_sites: usize,
+    /// The per-frame table, the summary and the chart, relative to the output folder.
+    pub csv: PathBuf,
+    /// See `csv`.
+    pub json: PathBuf,
+    /// See `csv`.
+    pub chart: PathBuf,
+}
+
+/// Runs the job: offline maps from the probe, then every frame.
+pub fn run_outdoor(job: &OutdoorJob, progress: &dyn Progress) -> Result<OutdoorSummary> {
+    check_output_folder(&job.out_dir)?;
+    let scene_shown = job.scene.display().to_string();
+    let loaded = ibl_io::read_scene(&job.scene)?;
+    let outdoor = loaded.description.outdoor.clone().ok_or_else(|| {
+        PipelineError::parameter(format!(
+            "{scene_shown}: has no [outdoor] table (docs/SCENES.md): `ibl outdoor` needs the site, the probe's time, the mask and the frames"
+        ))
+    })?;
+    let base = job.scene.parent().unwrap_or(Path::new("."));
+    let frames_dir = base.join(&outdoor.frames.source);
+    let frame_files = list_frames(&frames_dir, job.max_frames)?;
+    let mask_path = base.join(&outdoor.mask);
+    check_outputs(job, &loaded.inputs, &frame_files, &mask_path)?;
+    let location = location(&outdoor);
+    let probe_time = timestamp(&outdoor.probe_local_time()?, outdoor.utc_offset_hours)
+        .context(format!("{scene_shown}: outdoor.probe_time"))?;
+    let start = timestamp(
+        &outdoor.frames.start_local_time()?,
+        outdoor.utc_offset_hours,
+    )
+    .context(format!("{scene_shown}: outdoor.frames.start"))?;
+    let start_hour = civil_hour(&outdoor.frames.start_local_time()?);
+    let mask = read_mask(&mask_path)?;
+
+    let scene = &loaded.scene;
+    let settings = system_settings(&outdoor, scene)?;
+    progress.begin("outdoor: offline maps and sample sites", 0);
+    let setup_start = Instant::now();
+    let system = OutdoorSystem::new(
+        scene.real.clone(),
+        location,
+        &ProbeCapture {
+            radiance: scene.probe.radiance.clone(),
+            position: scene.probe.position,
+            world_from_probe: scene.probe.world_from_probe,
+            time: probe_time,
+            lighting: CaptureSource::Measured,
+        },
+        &CameraSetup {
+            camera: scene.camera,
+            frame_size: (mask.width(), mask.height()),
+            mask: mask.clone(),
+        },
+        settings,
+    );
+    progress.end();
+    let mut system = system.context(&scene_shown)?;
+    let setup_seconds = setup_start.elapsed().as_secs_f64();
+    let compositor = (job.composites && scene.virtual_objects.triangle_count() > 0)
+        .then(|| {
+            FrameCompositor::new(
+                scene.real.clone(),
+                scene.virtual_objects.clone(),
+                scene.camera,
+                scene.probe.position,
+                scene.probe.world_from_probe,
+                job.composite,
+            )
+        })
+        .transpose()?;
+
+    ibl_io::create_dir_all(&job.out_dir)?;
+    for (wanted, dir) in [
+        (compositor.is_some(), "composites"),
+        (job.relit_maps, "relit"),
+    ] {
+        if wanted {
+            ibl_io::create_dir_all(&job.out_dir.join(dir))?;
+        }
+    }
+    progress.begin("outdoor: frames", frame_files.len() as u64);
+    let mut frames = Vec::with_capacity(frame_files.len());
+    let mut display: Option<WriteOptions> = None;
+    for (index, path) in frame_files.iter().enumerate() {
+        let frame = ibl_io::read_image(path)?.image;
+        if (frame.width(), frame.height()) != (mask.width(), mask.height()) {
+            return Err(PipelineError::parameter(format!(
+                "{}: {} x {} pixels, but the mask {} is {} x {}: frames and mask must be the same size",
+                path.display(),
+                frame.width(),
+                frame.height(),
+                mask_path.display(),
+                mask.width(),
+                mask.height()
+            )));
+        }
+        let after = outdoor.frames.seconds_after_start(index);
+        let time = start.plus_seconds(after);
+        let t0 = Instant::now();
+        let result = system
+            .process(time, &frame)
+            .context(path.display().to_string())?;
+        let estimate_seconds = t0.elapsed().as_secs_f64();
+        let name = frame_name(path, index);
+        let t1 = Instant::now();
+        let composite = match &compositor {
+            Some(c) => {
+                let lighting = system.frame_lighting(&result)?;
+                let out = c.composite(&frame, &lighting)?;
+                let options = display.get_or_insert_with(|| WriteOptions {
+                    display: Display {
+                        exposure_stops: auto_exposure_stops(&frame),
+                        ..Display::default()
+                    },
+                    ..WriteOptions::default()
+                });
+                let rel = PathBuf::from("composites").join(format!("{name}.exr"));
+                ibl_io::write_image(&job.out_dir.join(&rel), &out.composite, options)?;
+                ibl_io::write_image(
+                    &job.out_dir.join(rel.with_extension("png")),
+                    &out.composite,
+                    options,
+                )?;
+                Some(rel)
+            }
+            None => None,
+        };
+        let composite_seconds = t1.elapsed().as_secs_f64();
+        let relit_map = if job.relit_maps {
+            let rel = PathBuf::from("relit").join(format!("{name}.exr"));
+            ibl_io::write_image(
+                &job.out_dir.join(&rel),
+                system.relit_map(),
+                &WriteOptions::default(),
+            )?;
+            Some(rel)
+        } else {
+            None
+        };
+        let hour = start_hour + after / 3600.0;
+        frames.push(OutdoorFrame {
+            index,
+            file: path.clone(),
+            local_time: local_time_label(&outdoor.frames.start_local_time()?, after),
+            hour,
+            sun_elevation_deg: f64::from(result.sun_direction[1].clamp(-1.0, 1.0))
+                .asin()
+                .to_degrees(),
+            result,
+            composite,
+            relit_map,
+            estimate_seconds,
+            composite_seconds,
+        });
+        progress.update(index as u64 + 1, frame_files.len() as u64, None);
+    }
+    progress.end();
+
+    let summary = OutdoorSummary {
+        scene: job.scene.clone(),
+        sample_sites: system.sites().pixels().len(),
+        frames,
+        setup_seconds,
+        csv: PathBuf::from("estimates.csv"),
+        json: PathBuf::from("estimates.json"),
+        chart: PathBuf::from("estimates.svg"),
+    };
+    write_tables(&summary, &job.out_dir, &scene_shown)?;
+    Ok(summary)
+}
+
+/// The name of a frame's outputs: its file stem.
+fn frame_name(path: &Path, index: usize) -> String {
+    path.file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| format!("{index:05}"))
+}
+
+/// Checks, before any work, that no output lands on an input (the scene, what it names, the
+/// frames, the mask).
+fn check_outputs(
+    job: &OutdoorJob,
+    scene_inputs: &[PathBuf],
+    frames: &[PathBuf],
+    mask: &Path,
+) -> Result<()> {
+    let mut inputs: Vec<&Path> = vec![job.scene.as_path(), mask];
+    inputs.extend(scene_inputs.iter().map(PathBuf::as_path));
+    inputs.extend(frames.iter().map(PathBuf::as_path));
+    let mut outputs: Vec<PathBuf> = ["estimates.csv", "estimates.json", "estimates.svg"]
+        .iter()
+        .map(|f| job.out_dir.join(f))
+        .collect();
+    for (index, frame) in frames.iter().enumerate() {
+        let name = frame_name(frame, index);
+        if job.composites {
+            outputs.push(job.out_dir.join("composites").join(format!("{name}.exr")));
+            outputs.push(job.out_dir.join("composites").join(format!("{name}.png")));
+        }
+        if job.relit_maps {
+            outputs.push(job.out_dir.join("relit").join(format!("{name}.exr")));
+        }
+    }
+    for output in &outputs {
+        ibl_io::ensure_output_is_not_input(output, &inputs)?;
+    }
+    Ok(())
+}
+
+/// The frame files of `dir` (images with a [`FRAME_EXTENSIONS`] extension, by file name).
+fn list_frames(dir: &Path, max_frames: Option<usize>) -> Result<Vec<PathBuf>> {
+    if dir.is_file() {
+        return Err(PipelineError::parameter(format!(
+            "{}: outdoor.frames.source is a file; decoding video is not built yet: extract its frames first (`ffmpeg -i VIDEO {}/%05d.png`) and name that folder",
+            dir.display(),
+            dir.with_extension("").display()
+        )));
+    }
+    let mut files = ibl_io::list_dir(dir)?;
+    files.retain(|p| {
+        p.extension()
+            .is_some_and(|x| FRAME_EXTENSIONS.iter().any(|e| x.eq_ignore_ascii_case(e)))
+    });
+    if files.is_empty() {
+        return Err(PipelineError::parameter(format!(
+            "{}: no frames (images ending in .{})",
+            dir.display(),
+            FRAME_EXTENSIONS.join(", .")
+        )));
+    }
+    if files.len() > MAX_FRAMES {
+        return Err(PipelineError::parameter(format!(
+            "{}: {} frames, more than {MAX_FRAMES} in one run",
+            dir.display(),
+            files.len()
+        )));
+    }
+    files.truncate(max_frames.unwrap_or(usize::MAX).max(1));
+    Ok(files)
+}
+
+/// The mask image: every pixel with a non-zero channel is marked.
+fn read_mask(path: &Path) -> Result<Image<bool>> {
+    let image = ibl_io::read_image(path)?.image;
+    let mask = image.map(|p| p.max_channel() > 0.0);
+    if !mask.pixels().iter().any(|&m| m) {
+        return Err(PipelineError::parameter(format!(
+            "{}: the mask marks no pixel (non-black pixels are the diffuse surfaces the estimation samples)",
+            path.display()
+        )));
+    }
+    Ok(mask)
+}
+
+/// The site of the `[outdoor]` table.
+fn location(outdoor: &OutdoorDescription) -> Location {
+    Location {
+        elevation_m: outdoor.elevation_m,
+        utc_offset_hours: outdoor.utc_offset_hours,
+        north: outdoor.north_unit(),
+        atmosphere: Atmosphere {
+            pressure_mbar: outdoor.pressure_mbar,
+            temperature_c: outdoor.temperature_c,
+        },
+        ..Location::new(outdoor.latitude_deg, outdoor.longitude_deg)
+    }
+}
+
+/// The instant of a local civil time at `utc_offset_hours`.
+fn timestamp(civil: &CivilTime, utc_offset_hours: f64) -> Result<Timestamp> {
+    let &(year, month, day, hour, minute, second) = civil;
+    Ok(Timestamp::from_local(
+        year,
+        month,
+        day,
+        hour,
+        minute,
+        second,
+        utc_offset_hours,
+    )?)
+}
+
+/// Hours since local midnight.
+fn civil_hour(civil: &CivilTime) -> f64 {
+    let &(_, _, _, hour, minute, second) = civil;
+    f64::from(hour) + f64::from(minute) / 60.0 + second / 3600.0
+}
+
+/// `YYYY-MM-DDTHH:MM:SS` of `seconds` after `start` (whole days roll over the date's day only
+/// for the label; the instant itself comes from [`Timestamp`]).
+fn local_time_label(start: &CivilTime, seconds: f64) -> String {
+    let &(year, month, day, ..) = start;
+    let total = (civil_hour(start) * 3600.0 + seconds).round() as i64;
+    let (days, rest) = (total.div_euclid(86_400), total.rem_euclid(86_400));
+    format!(
+        "{year:04}-{month:02}-{:02}T{:02}:{:02}:{:02}",
+        i64::from(day) + days,
+        rest / 3600,
+        rest / 60 % 60,
+        rest % 60
+    )
+}
+
+/// The system's settings from the `[outdoor]` table: the sample count, smoothing, and a volume
+/// over the objects when `volume_spacing_m` is given.
+fn system_settings(
+    outdoor: &OutdoorDescription,
+    scene: &ibl_scene::Scene,
+) -> Result<SystemSettings> {
+    let volume = match outdoor.volume_spacing_m {
+        Some(spacing) => {
+            let (lo, hi) = scene
+                .virtual_objects
+                .bvh
+                .bounds()
+                .unwrap_or((scene.probe.position, scene.probe.position));
+            let margin = Vec3::splat(VOLUME_MARGIN_M as f32);
+            let grid =
+                VolumeGrid::covering((lo - margin).as_dvec3(), (hi + margin).as_dvec3(), spacing)?;
+            Some(VolumeSettings {
+                grid,
+                directions_width: VOLUME_DIRECTIONS,
+                refresh: VolumeRefresh::KeyPoints,
+            })
+        }
+        None => None,
+    };
+    Ok(SystemSettings {
+        samples: SampleSettings {
+            count: outdoor.samples as usize,
+            ..SampleSettings::default()
+        },
+        smoothing: outdoor.smoothing.then(SmoothingOptions::default),
+        volume,
+        ..SystemSettings::default()
+    })
+}
+
+/// A CSV field: quoted (with inner quotes doubled) when it holds a comma, a quote or a line break.
+fn csv_field(text: &str) -> String {
+    if text.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", text.replace('"', "\"\""))
+    } else {
+        text.to_string()
+    }
+}
+
+/// The chart of a run's estimates, with the true values when `truth` has one per frame.
+pub fn chart_svg(
+    summary: &OutdoorSummary,
+    truth: Option<&[([f32; 3], [f32; 3])]>,
+    title: &str,
+) -> Result<String> {
+    let points: Vec<SeriesPoint> = summary
+        .frames
+        .iter()
+        .map(|f| SeriesPoint {
+            hour: f.hour,
+            sun: f.result.estimate.sun,
+            sky: f.result.estimate.sky,
+            truth: truth.and_then(|t| t.get(f.index).copied()),
+            label: format!("{:?}", f.result.sky_condition).to_lowercase(),
+        })
+        .collect();
+    Ok(estimates_svg(&points, title, CHART_SIZE)?)
+}
+
+/// `estimates.csv`, `estimates.json` and `estimates.svg`.
+fn write_tables(summary: &OutdoorSummary, out_dir: &Path, scene: &str) -> Result<()> {
+    let mut csv = String::from(
+        "frame,file,local_time,sun_elevation_deg,sky,p_d_r,p_d_g,p_d_b,p_a_r,p_a_g,p_a_b,p_d_std_g,p_a_std_g,inliers,samples,composite\n",
+    );
+    for f in &summary.frames {
+        let e = &f.result.estimate;
+        csv.push_str(&format!(
+            "{},{},{},{:.3},{:?},{},{},{},{},{},{},{},{},{},{},{}\n",
+            f.index,
+            csv_field(&f.file.display().to_string()),
+            f.local_time,
+            f.sun_elevation_deg,
+            f.result.sky_condition,
+            e.sun[0],
+            e.sun[1],
+            e.sun[2],
+            e.sky[0],
+            e.sky[1],
+            e.sky[2],
+            e.sun_std[1],
+            e.sky_std[1],
+            e.inliers,
+            e.samples,
+            f.composite
+                .as_ref()
+                .map_or(String::new(), |p| csv_field(&p.display().to_string())),
+        ));
+    }
+    ibl_io::write_atomically(&out_dir.join(&summary.csv), csv.as_bytes())?;
+    // Serialising plain data to a string cannot fail (non-finite numbers become null).
+    let json = serde_json::to_string_pretty(summary).unwrap_or_default();
+    ibl_io::write_atomically(&out_dir.join(&summary.json), json.as_bytes())?;
+    let svg = chart_svg(summary, None, &format!("sun and sky over {scene}"))?;
+    ibl_io::write_atomically(&out_dir.join(&summary.chart), svg.as_bytes())?;
+    Ok(())
+}
