@@ -101,13 +101,12 @@ fn a_scene_without_an_outdoor_table_is_refused_naming_it() {
     );
 }
 
-#[test]
-fn a_missing_mask_is_bad_input_naming_the_file() {
-    let dir = tempfile::tempdir().unwrap();
+/// The bundled scene with `edit` applied, written into `dir` with its paths made absolute.
+fn edited_scene(dir: &Path, edit: impl Fn(String) -> String) -> String {
     let src = repo().join("assets/outdoor/courtyard");
     let scene = std::fs::read_to_string(src.join("scene.toml"))
         .unwrap()
-        .replace("mask = \"mask.png\"", "mask = \"no-such-mask.png\"")
+        .replace("\"mask.png\"", &format!("{:?}", src.join("mask.png")))
         .replace("\"probe.exr\"", &format!("{:?}", src.join("probe.exr")))
         .replace("\"model.obj\"", &format!("{:?}", src.join("model.obj")))
         .replace(
@@ -118,18 +117,49 @@ fn a_missing_mask_is_bad_input_naming_the_file() {
             "source = \"frames\"",
             &format!("source = {:?}", src.join("frames")),
         );
-    let path = dir.path().join("scene.toml");
-    std::fs::write(&path, scene).unwrap();
-    let out = ibl(&[
-        "outdoor",
-        path.to_str().unwrap(),
-        "--out",
-        dir.path().join("run").to_str().unwrap(),
-    ]);
+    let path = dir.join("scene.toml");
+    std::fs::write(&path, edit(scene)).unwrap();
+    path.display().to_string()
+}
+
+#[test]
+fn a_missing_mask_is_bad_input_naming_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = edited_scene(dir.path(), |s| {
+        let mask = format!("{:?}", repo().join("assets/outdoor/courtyard/mask.png"));
+        s.replace(&mask, "\"no-such-mask.png\"")
+    });
+    let run = dir.path().join("run");
+    let out = ibl(&["outdoor", &scene, "--out", run.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(
         stderr(&out).contains("no-such-mask.png"),
         "{}",
         stderr(&out)
     );
+}
+
+#[test]
+fn a_night_only_sequence_is_refused_before_the_offline_step() {
+    let dir = tempfile::tempdir().unwrap();
+    // 01:00 and 02:00 local time in Aalborg in April: the sun is well below the horizon.
+    let scene = edited_scene(dir.path(), |s| {
+        s.replace("start = 2024-04-20T10:00:00", "start = 2024-04-20T01:00:00")
+    });
+    let run = dir.path().join("run");
+    let out = ibl(&[
+        "outdoor",
+        &scene,
+        "--out",
+        run.to_str().unwrap(),
+        "--frames",
+        "2",
+    ]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    let err = stderr(&out);
+    assert!(
+        err.contains("below the horizon") && err.contains("skipped"),
+        "{err}"
+    );
+    assert!(err.contains("scene.toml"), "{err}");
 }

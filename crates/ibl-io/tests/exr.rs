@@ -315,6 +315,23 @@ fn luminance_chroma_and_empty_images_are_refused() {
     }
 }
 
+/// An R-only file (a mask, one channel of a render) is refused by what it lacks: the message
+/// names the missing channels and lists the ones it has (issue 13, hostile 8: it used to say
+/// "without R, G, B or Y channels (channels: R)").
+#[test]
+fn an_r_only_file_is_refused_naming_what_is_missing() {
+    let r = vec![("R", x::FlatSamples::F32(vec![1.0; 4]))];
+    let bytes = single(layer((2, 2), None, r, x::Encoding::SMALL_LOSSLESS));
+    let err = exr::decode(&bytes, &Limits::default()).expect_err("one channel is not colour");
+    let DecodeError::Unsupported(m) = &err else {
+        panic!("{err}")
+    };
+    assert!(
+        m.contains("missing G, B") && m.contains("its channels: R"),
+        "{m}"
+    );
+}
+
 /// The lossy and lossless-for-half compressions only the `exr` crate writes (PXR24, B44, B44A,
 /// DWAA, DWAB) are read by our decoder exactly as the crate's own reader reads them: the
 /// compressions are lossy on writing, so the reference is the crate's decoding, not the input.

@@ -102,8 +102,10 @@ pub struct OutdoorFrame {
 pub struct OutdoorSummary {
     /// The scene file.
     pub scene: PathBuf,
-    /// Frames read, in order.
+    /// Frames processed, in order.
     pub frames: Vec<OutdoorFrame>,
+    /// Frames skipped because the sun was below the horizon at their time.
+    pub skipped: Vec<PathBuf>,
     /// Seconds of the offline step (maps, sample sites, volume weights).
     pub setup_seconds: f64,
     /// Sample sites drawn on the marked surfaces.
@@ -144,6 +146,22 @@ pub fn run_outdoor(job: &OutdoorJob, progress: &dyn Progress) -> Result<OutdoorS
 
     let scene = &loaded.scene;
     let settings = system_settings(&outdoor, scene)?;
+    // Each frame's time and whether the sun is up then: the model is for daylight, so a night
+    // frame is skipped with a note, and a sequence with no daylight frame is refused before the
+    // offline step.
+    let start_civil = outdoor.frames.start_local_time()?;
+    let mut timed = Vec::with_capacity(frame_files.len());
+    for index in 0..frame_files.len() {
+        let after = outdoor.frames.seconds_after_start(index);
+        let time = start.plus_seconds(after);
+        let daylight = location.sun_direction(time, settings.delta_t)?.y > 0.0;
+        timed.push((after, time, local_time_label(&start_civil, after), daylight));
+    }
+    if !timed.iter().any(|t| t.3) {
+        return Err(PipelineError::parameter(format!(
+            "{scene_shown}: the sun is below the horizon at every frame's time, so every frame would be skipped (check outdoor.frames.start and utc_offset_hours)"
+        )));
+    }
     progress.begin("outdoor: offline maps and sample sites", 0);
     let setup_start = Instant::now();
     let system = OutdoorSystem::new(
@@ -191,7 +209,18 @@ pub fn run_outdoor(job: &OutdoorJob, progress: &dyn Progress) -> Result<OutdoorS
     progress.begin("outdoor: frames", frame_files.len() as u64);
     let mut frames = Vec::with_capacity(frame_files.len());
     let mut display: Option<WriteOptions> = None;
-    for (index, path) in frame_files.iter().enumerate() {
+    let mut skipped = Vec::new();
+    for (index, (path, (after, time, local_time, daylight))) in
+        frame_files.iter().zip(timed).enumerate()
+    {
+        if !daylight {
+            progress.note(&format!(
+                "{}: the sun is below the horizon at {local_time}: skipped",
+                path.display()
+            ));
+            skipped.push(path.clone());
+            continue;
+        }
         let frame = ibl_io::read_image(path)?.image;
         if (frame.width(), frame.height()) != (mask.width(), mask.height()) {
             return Err(PipelineError::parameter(format!(
@@ -204,8 +233,6 @@ pub fn run_outdoor(job: &OutdoorJob, progress: &dyn Progress) -> Result<OutdoorS
                 mask.height()
             )));
         }
-        let after = outdoor.frames.seconds_after_start(index);
-        let time = start.plus_seconds(after);
         let t0 = Instant::now();
         let result = system
             .process(time, &frame)
@@ -251,7 +278,7 @@ pub fn run_outdoor(job: &OutdoorJob, progress: &dyn Progress) -> Result<OutdoorS
         frames.push(OutdoorFrame {
             index,
             file: path.clone(),
-            local_time: local_time_label(&outdoor.frames.start_local_time()?, after),
+            local_time,
             hour,
             sun_elevation_deg: f64::from(result.sun_direction[1].clamp(-1.0, 1.0))
                 .asin()
@@ -265,9 +292,9 @@ pub fn run_outdoor(job: &OutdoorJob, progress: &dyn Progress) -> Result<OutdoorS
         progress.update(index as u64 + 1, frame_files.len() as u64, None);
     }
     progress.end();
-
     let summary = OutdoorSummary {
         scene: job.scene.clone(),
+        skipped,
         sample_sites: system.sites().pixels().len(),
         frames,
         setup_seconds,

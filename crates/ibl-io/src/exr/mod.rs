@@ -130,8 +130,15 @@ fn select(parts: &[Part]) -> Result<(usize, Selection), DecodeError> {
             "luminance/chroma OpenEXR (Y, RY, BY channels); convert it to RGB".into(),
         ));
     }
+    // Name what is missing: an R-only file (a mask, one channel of a render) has an R channel,
+    // so "without R, G, B or Y" would contradict its own list (issue 13, hostile 8).
+    let missing: Vec<&str> = ["R", "G", "B"]
+        .into_iter()
+        .filter(|c| !names.iter().any(|n| n.rsplit('.').next() == Some(*c)))
+        .collect();
     Err(DecodeError::Unsupported(format!(
-        "OpenEXR file without R, G, B or Y channels (channels: {})",
+        "OpenEXR file with neither the three colour channels R, G and B (missing {}) nor a luminance channel Y (its channels: {})",
+        missing.join(", "),
         names.join(", ")
     )))
 }
