@@ -221,6 +221,185 @@ fn bad_input_is_refused_with_status_2() {
     assert_eq!(std::fs::read(&probe).unwrap(), before);
 }
 
+/// Pixels of `image` that are exactly `colour`.
+fn count_exactly(image: &ibl_core::Image<[u8; 3]>, colour: [u8; 3]) -> usize {
+    image.pixels().iter().filter(|&&p| p == colour).count()
+}
+
+/// Whether a pixel within `r` of `(x, y)` is exactly `colour`.
+fn near(image: &ibl_core::Image<[u8; 3]>, (x, y): (f64, f64), r: i64, colour: [u8; 3]) -> bool {
+    let (cx, cy) = (x.floor() as i64, y.floor() as i64);
+    (-r..=r).any(|dy| {
+        (-r..=r).any(|dx| {
+            let (px, py) = (cx + dx, cy + dy);
+            px >= 0
+                && py >= 0
+                && (px as usize) < image.width()
+                && (py as usize) < image.height()
+                && *image.get(px as usize, py as usize) == colour
+        })
+    })
+}
+
+fn read_png(path: &Path) -> ibl_core::Image<[u8; 3]> {
+    let bytes = std::fs::read(path).unwrap();
+    ibl_io::photo::decode_codes(&bytes, &ibl_io::Limits::default()).unwrap()
+}
+
+#[test]
+fn the_room_overlays_draw_the_marks_and_the_room_over_the_probe() {
+    let dir = tempfile::tempdir().unwrap();
+    let apartment = repo().join("assets/rooms/apartment");
+    let marks = apartment.join("marks.json");
+    let room = apartment.join("room.toml");
+    let probe = common::probe("apartment.exr");
+    // The marks file's "front" view exactly: yaw 0, 90 degrees vertical over 800 x 600, so its
+    // marks' pixels are this frame's pixels.
+    let shot = |name: &str, extra: &[&str]| {
+        let png = dir.path().join(name);
+        let mut args = vec![
+            "view",
+            probe.as_str(),
+            "--headless",
+            "--overlay",
+            "none",
+            "--size",
+            "800x600",
+            "--yaw",
+            "0",
+            "--fov",
+            "90",
+            "-o",
+            png.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        (ibl(&args), png)
+    };
+    let (out, overlaid) = shot(
+        "room.png",
+        &[
+            "--marks",
+            marks.to_str().unwrap(),
+            "--room",
+            room.to_str().unwrap(),
+        ],
+    );
+    if no_adapter(&out, "room overlays") {
+        return;
+    }
+    assert!(out.status.success(), "{}", stderr(&out));
+    let (out, plain) = shot("plain.png", &[]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let (overlaid, plain) = (read_png(&overlaid), read_png(&plain));
+    assert_eq!((overlaid.width(), overlaid.height()), (800, 600));
+    let text = std::fs::read_to_string(&marks).unwrap();
+    let v: Value = serde_json::from_str(&text).unwrap();
+    let front = &v["views"][0];
+    assert_eq!(front["name"], "front");
+    let colour = |axis: &str| match axis {
+        "x" => [255, 0, 0],
+        "y" => [0, 255, 0],
+        _ => [0, 0, 255],
+    };
+    for line in front["lines"].as_array().unwrap() {
+        let c = colour(line["axis"].as_str().unwrap());
+        let end = |k: &str| {
+            let p = line[k].as_array().unwrap();
+            (p[0].as_f64().unwrap(), p[1].as_f64().unwrap())
+        };
+        let (a, b) = (end("from"), end("to"));
+        let mid = (0.5 * (a.0 + b.0), 0.5 * (a.1 + b.1));
+        // The line's middle and its ends (discs) are the axis's pure colour; the probe there is not.
+        assert!(near(&overlaid, mid, 1, c), "{line} at {mid:?}");
+        assert!(!near(&plain, mid, 1, c), "the probe alone at {mid:?}");
+        for p in [a, b] {
+            let any_axis = [[255, 0, 0], [0, 255, 0], [0, 0, 255]]
+                .iter()
+                .any(|&c| near(&overlaid, p, 1, c));
+            assert!(any_axis, "{line}: no end disc at {p:?}");
+        }
+    }
+    // The room's edges in white: many more pure white pixels than the probe has.
+    let white = count_exactly(&overlaid, [255, 255, 255]);
+    let before = count_exactly(&plain, [255, 255, 255]);
+    assert!(
+        white > before + 800,
+        "{white} white pixels against {before}"
+    );
+    // The flat lat-long view draws them too.
+    let (out, flat) = shot(
+        "flat.png",
+        &[
+            "--flat",
+            "--marks",
+            marks.to_str().unwrap(),
+            "--room",
+            room.to_str().unwrap(),
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let flat = read_png(&flat);
+    for c in [[255, 0, 0], [0, 255, 0], [0, 0, 255], [255, 255, 255]] {
+        assert!(count_exactly(&flat, c) > 20, "{c:?} in the flat view");
+    }
+}
+
+#[test]
+fn a_bad_marks_or_room_file_is_refused_with_status_2() {
+    let dir = tempfile::tempdir().unwrap();
+    let probe = common::probe("apartment.exr");
+    let bad = dir.path().join("bad-marks.json");
+    std::fs::write(
+        &bad,
+        r#"{"format": "iblkit.marks/1", "views": [{"name": "v",
+            "camera": {"yaw_deg": 0, "vertical_fov_deg": 90, "width": 8, "height": 6},
+            "lines": [{"axis": "w", "from": [1, 1], "to": [5, 5]}]}]}"#,
+    )
+    .unwrap();
+    let bad = bad.to_str().unwrap();
+    refuses(
+        &["view", &probe, "--marks", bad, "--headless"],
+        "bad-marks.json",
+    );
+    refuses(&["view", &probe, "--marks", bad, "--headless"], "lines[0]");
+    // The window refuses it before it opens (no display needed).
+    refuses(&["view", &probe, "--marks", bad], "bad-marks.json");
+    let missing = dir.path().join("missing.json");
+    refuses(
+        &[
+            "view",
+            &probe,
+            "--marks",
+            missing.to_str().unwrap(),
+            "--headless",
+        ],
+        "missing.json",
+    );
+    let room = dir.path().join("bad-room.toml");
+    std::fs::write(&room, "version = 1\n[probe]\nfile = 3\n").unwrap();
+    refuses(
+        &[
+            "view",
+            &probe,
+            "--room",
+            room.to_str().unwrap(),
+            "--headless",
+        ],
+        "bad-room.toml",
+    );
+    refuses(&["view", &probe, "--pitch", "95", "--headless"], "pitch");
+    refuses(
+        &[
+            "view",
+            &scene("bunny-sky.toml"),
+            "--marks",
+            bad,
+            "--headless",
+        ],
+        "probe",
+    );
+}
+
 /// The command that runs `ibl` with a display: directly when `DISPLAY` is set, else through
 /// `xvfb-run -a` (None when neither exists).
 fn with_display() -> Option<Command> {

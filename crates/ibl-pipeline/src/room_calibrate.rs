@@ -12,8 +12,8 @@ use std::path::{Path, PathBuf};
 
 use ibl_core::glam::{DMat3, DVec3};
 use ibl_room::{
-    Calibration, ManhattanProposal, ManhattanSettings, Scale, calibrate, line_observations,
-    probe_height, propose_manhattan_frame, reconstruct,
+    Calibration, ManhattanProposal, ManhattanSettings, MarksFile, Scale, calibrate,
+    line_observations, probe_height, propose_manhattan_frame, reconstruct,
 };
 use serde::Serialize;
 
@@ -116,19 +116,47 @@ fn check(o: &CalibrateOptions) -> Result<()> {
     Ok(())
 }
 
+/// The frame and the scale of parsed marks.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MarksCalibration {
+    /// Marked lines used (segments whose ends are distinct directions).
+    pub lines: usize,
+    /// Frame, vanishing points and residuals (each line's, in the marks file's order).
+    pub calibration: Calibration,
+    /// The probe's height (absent when the marks have no scale marks).
+    pub scale: Option<Scale>,
+}
+
+/// The calibration of parsed marks: the vanishing points, `world_from_probe` with every line's
+/// residual, and the probe's height from the scale marks; what [`room_calibrate`] computes
+/// before it writes anything (the viewer's "calibrate" runs it on the marks being edited).
+/// `name` names the marks in errors.
+pub fn calibrate_marks(marks: &MarksFile, name: &str) -> Result<MarksCalibration> {
+    let lines = line_observations(marks);
+    let calibration = calibrate(&lines).context(name.to_string())?;
+    let scale = if marks.scale.is_empty() {
+        None
+    } else {
+        Some(probe_height(marks, calibration.world_from_probe()).context(name.to_string())?)
+    };
+    Ok(MarksCalibration {
+        lines: lines.len(),
+        calibration,
+        scale,
+    })
+}
+
 /// Calibrates, scales, optionally proposes, and writes the room file.
 pub fn room_calibrate(o: &CalibrateOptions, progress: &dyn Progress) -> Result<CalibrateResult> {
     check(o)?;
     let name = o.marks.display().to_string();
     let marks = read_marks(&o.marks)?;
-    let lines = line_observations(&marks);
-    let calibration = calibrate(&lines).context(name.clone())?;
+    let MarksCalibration {
+        lines,
+        calibration,
+        scale,
+    } = calibrate_marks(&marks, &name)?;
     let world_from_probe = calibration.world_from_probe();
-    let scale = if marks.scale.is_empty() {
-        None
-    } else {
-        Some(probe_height(&marks, world_from_probe).context(name.clone())?)
-    };
     let marks_folder = absolute_folder(&o.marks)?;
     // Canonical where the probe exists, so the room file names it without `a/../` detours.
     let probe_path = marks.probe.as_ref().map(|p| {
@@ -176,7 +204,7 @@ pub fn room_calibrate(o: &CalibrateOptions, progress: &dyn Progress) -> Result<C
             "# Made by `ibl room calibrate {name} -o {}`: {} lines, RMS residual {:.3} deg; \
              probe {:.3} m above the floor.\n",
             out.display(),
-            lines.len(),
+            lines,
             calibration.rms_residual_deg,
             scale.probe_height_m
         );
@@ -185,7 +213,7 @@ pub fn room_calibrate(o: &CalibrateOptions, progress: &dyn Progress) -> Result<C
         progress.note(&format!("wrote {}", out.display()));
     }
     Ok(CalibrateResult {
-        lines: lines.len(),
+        lines,
         calibration,
         scale,
         proposal,

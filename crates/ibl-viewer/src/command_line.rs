@@ -12,7 +12,7 @@ use crate::headless::{self, HeadlessOptions, Motion};
 use crate::probe_model::Overlays;
 use crate::probe_pass::{ProbeLayer, ProbeProjection};
 use crate::scene_renderer::GlossySource;
-use crate::view_job::{ProbeViewOptions, ViewJob, ViewSummary};
+use crate::view_job::{ProbeExtras, ProbeViewOptions, ViewJob, ViewSummary, is_scene};
 use crate::window::{self, WindowOptions};
 use crate::{Mapping, ViewerError};
 
@@ -65,11 +65,18 @@ Examples:
   ibl view assets/scenes/bunny-sky.toml --headless --bench --frames 120
   ibl view probe.exr --headless --flat --method lightgen -n 32 -o lights.png
   ibl view scene.toml --screenshot window.png           open the window, save it with its UI, quit
+  ibl view probe.exr --marks marks.json --room room.toml  marked lines and the room over the probe
+  ibl view probe.exr --marks marks.json --headless --yaw 30 --fov 100 -o shot.png
 
 In the window: left-drag turns the camera (or moves the object under the cursor), Shift-drag
 turns the object, Ctrl-drag scales it, right-drag pans, the wheel zooms; F12 saves the frame as
 EXR and PNG, Ctrl+S saves the scene, F11 toggles full screen; drop a probe or scene file onto the
-window to open it. -o FRAME writes FRAME and FRAME's .exr (or .png) twin.")]
+window to open it. -o FRAME writes FRAME and FRAME's .exr (or .png) twin.
+
+Room tools (probe; docs/ROOMS.md): marked lines are drawn x red, y green, z blue, the room's
+edges white. In the window's Room section, M switches marking on: a left-drag draws a line
+(right-drag turns), X/Y/Z pick its axis, Backspace removes the last; \"calibrate\" runs `ibl
+room calibrate`'s calibration, \"save marks\" writes the marks file.")]
 pub struct ViewArgs {
     /// A probe (any format and mapping ibl reads) or a scene file (.toml, docs/SCENES.md).
     pub input: PathBuf,
@@ -134,6 +141,35 @@ pub struct ViewArgs {
     /// Background rays per pixel axis (4, as `ibl render`, antialiases the magnified probe).
     #[arg(long, value_name = "N", default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=8))]
     pub background_rays: u32,
+    /// Marks file (`iblkit.marks/1`, docs/ROOMS.md) whose lines are drawn over a probe; the
+    /// window's Room section adds to them and saves them.
+    #[arg(long, value_name = "MARKS.json")]
+    pub marks: Option<PathBuf>,
+    /// Room file (docs/ROOMS.md) whose edges are drawn over a probe, seen from its probe.
+    #[arg(long, value_name = "ROOM.toml")]
+    pub room: Option<PathBuf>,
+    /// Camera yaw over a probe, degrees (0 looks along -Z, positive looks left).
+    #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
+    pub yaw: Option<f32>,
+    /// Camera pitch over a probe, degrees (positive looks up), -89 to 89.
+    #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
+    pub pitch: Option<f32>,
+    /// Vertical field of view over a probe, degrees, 10 to 150 (default 75).
+    #[arg(long, value_name = "DEG")]
+    pub fov: Option<f32>,
+}
+
+impl ViewArgs {
+    /// The probe's camera and room overlays the arguments ask for.
+    pub fn probe_extras(&self) -> ProbeExtras {
+        ProbeExtras {
+            yaw_deg: self.yaw,
+            pitch_deg: self.pitch,
+            fov_deg: self.fov,
+            marks: self.marks.clone(),
+            room: self.room.clone(),
+        }
+    }
 }
 
 /// `WxH`, each side 1 to the viewer's limit.
@@ -186,18 +222,27 @@ fn overlays(text: &str) -> Result<Overlays, String> {
 /// Runs `ibl view`: the window until it is closed (`None`), or the headless job and its
 /// summary.
 pub fn run(args: &ViewArgs, progress: &dyn Progress) -> Result<Option<ViewSummary>, ViewerError> {
+    let extras = args.probe_extras();
     if !args.headless {
         if args.output.is_some() || args.bench || args.frames.is_some() {
             return Err(ViewerError::Parameter(
                 "-o, --frames and --bench need --headless".into(),
             ));
         }
+        if is_scene(&args.input) && !extras.is_empty() {
+            return Err(ViewerError::Parameter(
+                "--marks, --room, --yaw, --pitch and --fov apply to a probe, not a scene".into(),
+            ));
+        }
+        // A bad angle, marks or room file is the command's error (status 2), before any window.
+        extras.check()?;
         window::run(WindowOptions {
             input: Some(args.input.clone()),
             mapping: args.mapping,
             size: args.size,
             screenshot: args.screenshot.clone(),
             shadow_tile: args.shadow_size,
+            probe: extras,
         })?;
         return Ok(None);
     }
@@ -240,5 +285,5 @@ pub fn run(args: &ViewArgs, progress: &dyn Progress) -> Result<Option<ViewSummar
             overlays: args.overlay,
         },
     };
-    job.run(progress).map(Some)
+    job.run_with(&extras, progress).map(Some)
 }

@@ -19,6 +19,9 @@ pub enum ViewerError {
     /// A file could not be read or written.
     #[error(transparent)]
     Io(#[from] ibl_io::IoError),
+    /// A marks or room file could not be read or used (the message names the file and field).
+    #[error(transparent)]
+    Room(#[from] ibl_pipeline::PipelineError),
     /// A file was read but cannot be viewed (the message says why).
     #[error("{}: {problem}", path.display())]
     Input {
@@ -46,6 +49,7 @@ impl ViewerError {
     pub fn is_bad_input(&self) -> bool {
         match self {
             ViewerError::Io(e) => e.is_bad_input(),
+            ViewerError::Room(e) => e.is_bad_input(),
             ViewerError::Input { .. } | ViewerError::Parameter(_) | ViewerError::Lighting(_) => {
                 true
             }

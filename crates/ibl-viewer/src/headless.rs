@@ -20,6 +20,7 @@ use crate::gpu::{AdapterSummary, GpuContext};
 use crate::lighting::{SceneLighting, SceneLightingRequest, scene_lighting};
 use crate::probe_model::{ProbeModel, ProbeViewSettings};
 use crate::probe_renderer::ProbeRenderer;
+use crate::room_overlay::{OverlayView, RoomOverlay};
 use crate::scene_model::SceneModel;
 use crate::scene_renderer::{GlossySource, SceneFrameSettings, SceneRenderer};
 use crate::timing::{PassTimes, median_p95};
@@ -286,6 +287,18 @@ pub fn render_probe(
     options: &HeadlessOptions,
     progress: &dyn Fn(usize, usize),
 ) -> Result<HeadlessRun, ViewerError> {
+    render_probe_with(gpu, model, settings, options, None, progress)
+}
+
+/// [`render_probe`] with the room overlays drawn over every frame (marked lines, room edges).
+pub fn render_probe_with(
+    gpu: &GpuContext,
+    model: &ProbeModel,
+    settings: &ProbeViewSettings,
+    options: &HeadlessOptions,
+    room: Option<&RoomOverlay>,
+    progress: &dyn Fn(usize, usize),
+) -> Result<HeadlessRun, ViewerError> {
     let (w, h) = options.size;
     let mut renderer = ProbeRenderer::new(gpu, model, w, h)?;
     let started = Instant::now();
@@ -322,7 +335,10 @@ pub fn render_probe(
                 .turn(std::f32::consts::TAU * k as f32 / frames as f32, 0.0);
         }
         let started = Instant::now();
-        let cpu_seconds = renderer.render(gpu, &view, 1.0);
+        let segments = room
+            .map(|r| r.segments(&OverlayView::of_settings(&view, w, h), 1.0))
+            .unwrap_or_default();
+        let cpu_seconds = renderer.render_with(gpu, &view, 1.0, &segments);
         finish(gpu)?;
         let wall_seconds = started.elapsed().as_secs_f64();
         let passes = renderer.read_pass_times(gpu, true);

@@ -11,6 +11,9 @@
 //! - [`lighting`]: lights, hybrid ambient and probe overlays, through the library.
 //! - [`worker`]: a background thread answering only the latest request.
 //! - [`view_camera`]: the pinhole camera of `ibl_scene` as a projection, and orbit controls.
+//! - [`room_overlay`]: a marks file's lines and a room file's edges as segments in the current
+//!   view (Grosch 2005 section 3.1); [`room_marking`]: the marks being edited in the window
+//!   (adding lines, calibrating, saving).
 //! - [`light_space`]: orthographic shadow projections and the atlas layout.
 //!
 //! GPU:
@@ -19,10 +22,12 @@
 //! - [`environment_maps`]: the probe's mip chains (box and Phong-prefiltered).
 //! - [`shadow_atlas`]: one shadow map per light, cached by what moves.
 //! - [`scene_pass`]: shading and the differential composite; [`probe_pass`]: the probe viewer;
-//!   [`display_pass`]: exposure and tone curves; [`markers_pass`]: light markers.
+//!   [`display_pass`]: exposure and tone curves; [`markers_pass`]: light markers;
+//!   [`lines_pass`]: antialiased lines (the room overlays).
 //! - [`scene_renderer`], [`probe_renderer`]: one frame each; [`timing`]: GPU pass timestamps.
 //! - [`headless`]: offscreen frames and the benchmark; [`window`]: the eframe application,
-//!   [`view_state`] what it has open, [`panels`] its widgets, [`scene_save`] saving the scene.
+//!   [`view_state`] what it has open, [`panels`] its widgets ([`room_panel`] the room tools'),
+//!   [`scene_save`] saving the scene.
 //!
 //! The extension points the indoor and outdoor pipelines plug into: [`lighting::SceneLighting`]
 //! is the light list a frame draws (directional lights now; area patches, goniometric lights and
@@ -42,11 +47,15 @@ pub mod gpu_scene;
 pub mod headless;
 pub mod light_space;
 pub mod lighting;
+pub mod lines_pass;
 pub mod markers_pass;
 pub mod panels;
 pub mod probe_model;
 pub mod probe_pass;
 pub mod probe_renderer;
+pub mod room_marking;
+pub mod room_overlay;
+pub mod room_panel;
 pub mod scene_geometry;
 pub mod scene_model;
 pub mod scene_pass;
@@ -68,4 +77,4 @@ pub use headless::{HeadlessOptions, HeadlessRun, Motion};
 pub use ibl_mapping::Mapping;
 pub use probe_model::{ProbeModel, ProbeViewSettings};
 pub use scene_model::SceneModel;
-pub use view_job::{ViewJob, ViewSummary};
+pub use view_job::{ProbeExtras, ViewJob, ViewSummary};

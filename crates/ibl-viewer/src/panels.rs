@@ -1,4 +1,5 @@
-//! The window's widgets: the side panel (view, display, lights, the selected object, saving),
+//! The window's widgets: the side panel (view, display, lights, the room tools of
+//! [`crate::room_panel`], the selected object, saving),
 //! the status line (frame rate, lights, shadow maps, GPU, messages) and the messages over an
 //! empty or failed view.
 
@@ -150,6 +151,9 @@ fn probe_panel(ui: &mut egui::Ui, p: &mut ProbeState) {
             ));
         }
     }
+    ui.separator();
+    let look_around = p.settings.projection == ProbeProjection::LookAround;
+    crate::room_panel::room_section(ui, &mut p.room, look_around);
     ui.separator();
     if let Some((d, l)) = p.cursor {
         let elevation = d.y.clamp(-1.0, 1.0).asin().to_degrees();
@@ -497,6 +501,9 @@ pub fn status_bar(ui: &mut egui::Ui, content: &Content, status: StatusLine<'_>) 
                 Content::Probe(p) => {
                     if let Some(o) = p.overlay() {
                         ui.label(format!("{} lights", o.set.lights.len()));
+                    }
+                    if p.marking_lines() {
+                        ui.label(format!("marking {} lines", p.room.axis.name()));
                     }
                 }
                 Content::Empty => {}

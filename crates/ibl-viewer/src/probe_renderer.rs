@@ -1,5 +1,5 @@
 //! One frame of the probe viewer, the same code in the window and headless: the probe pass, the
-//! display transform and the light markers.
+//! display transform, the light markers and the room overlays' lines.
 
 use glam::Mat3;
 
@@ -9,6 +9,7 @@ use crate::environment_maps::EnvironmentMaps;
 use crate::frame_targets::FrameTargets;
 use crate::gpu::GpuContext;
 use crate::lighting::ProbeOverlay;
+use crate::lines_pass::{LineSegment, LinesPass};
 use crate::markers_pass::MarkersPass;
 use crate::probe_model::{ProbeModel, ProbeViewSettings};
 use crate::probe_pass::{ProbeFrame, ProbePass, mask_texture};
@@ -21,6 +22,7 @@ pub struct ProbeRenderer {
     probe_pass: ProbePass,
     display: DisplayPass,
     markers: MarkersPass,
+    lines: LinesPass,
     irradiance: HdrTexture,
     regions: wgpu::TextureView,
     overlay: Option<ProbeOverlay>,
@@ -41,6 +43,7 @@ impl ProbeRenderer {
             probe_pass: ProbePass::new(gpu),
             display: DisplayPass::new(gpu),
             markers: MarkersPass::new(gpu),
+            lines: LinesPass::new(gpu),
             irradiance: black_texture(&gpu.device, &gpu.queue, "no irradiance"),
             regions: mask_texture(gpu, None),
             overlay: None,
@@ -85,6 +88,18 @@ impl ProbeRenderer {
 
     /// Draws a frame and submits it; `scale` sizes the markers (pixels per point).
     pub fn render(&mut self, gpu: &GpuContext, settings: &ProbeViewSettings, scale: f32) -> f64 {
+        self.render_with(gpu, settings, scale, &[])
+    }
+
+    /// [`ProbeRenderer::render`] with `segments` (output pixels, [`crate::room_overlay`]) drawn
+    /// over the markers; returns the CPU seconds.
+    pub fn render_with(
+        &mut self,
+        gpu: &GpuContext,
+        settings: &ProbeViewSettings,
+        scale: f32,
+        segments: &[LineSegment],
+    ) -> f64 {
         let started = std::time::Instant::now();
         let (w, h) = self.targets.size;
         let mut encoder = gpu
@@ -122,6 +137,11 @@ impl ProbeRenderer {
             let t = self.timer.as_mut().and_then(|t| t.writes(2));
             self.markers
                 .record(gpu, &mut encoder, &self.targets, &markers, 2.0 * scale, t);
+        }
+        if !segments.is_empty() {
+            let t = self.timer.as_mut().and_then(|t| t.writes(3));
+            self.lines
+                .record(gpu, &mut encoder, &self.targets, segments, t);
         }
         if let Some(timer) = self.timer.as_mut() {
             timer.resolve(&mut encoder);

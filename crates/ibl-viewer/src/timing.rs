@@ -16,7 +16,7 @@ use crate::gpu::GpuContext;
 /// The passes of a scene frame, in the order they run.
 pub const SCENE_PASSES: [&str; 4] = ["real shadows", "virtual shadows", "scene", "display"];
 /// The passes of a probe frame.
-pub const PROBE_PASSES: [&str; 3] = ["probe", "display", "markers"];
+pub const PROBE_PASSES: [&str; 4] = ["probe", "display", "markers", "room overlay"];
 
 /// Bytes between the resolved timestamps of two passes (wgpu resolves only to 256-byte
 /// aligned offsets).

@@ -14,13 +14,16 @@ use ibl_extract::ModelSpec;
 use ibl_light::LightSource;
 use ibl_mapping::Mapping;
 use ibl_pipeline::Progress;
+use ibl_pipeline::room_input::{read_marks, read_room};
 use serde::Serialize;
 
 use crate::gpu::AdapterSummary;
 use crate::headless::{self, HeadlessOptions, HeadlessRun, Motion, RunStatistics};
 use crate::probe_model::{Overlays, ProbeModel, ProbeViewSettings};
 use crate::probe_pass::{ProbeLayer, ProbeProjection};
+use crate::room_overlay::RoomOverlay;
 use crate::scene_model::SceneModel;
+use crate::view_camera::OrbitControl;
 use crate::{GpuContext, ViewerError};
 
 /// Most SH bands the viewer's irradiance layer and ambient take.
@@ -39,6 +42,88 @@ pub struct ProbeViewOptions {
     pub sharpen: f32,
     /// Which overlays are drawn.
     pub overlays: Overlays,
+}
+
+/// Options of a probe view beyond [`ProbeViewOptions`]: where the camera looks, and the room
+/// overlays (Grosch 2005 section 3.1, docs/ROOMS.md): a marks file's lines and a room file's
+/// edges drawn over the panorama ([`crate::room_overlay`]). The default changes nothing.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ProbeExtras {
+    /// The camera's yaw, degrees (about the probe's +Y; 0 looks along -Z, positive looks left).
+    pub yaw_deg: Option<f32>,
+    /// Its pitch, degrees (positive looks up), within +-89.
+    pub pitch_deg: Option<f32>,
+    /// Its vertical field of view, degrees, 10 to 150.
+    pub fov_deg: Option<f32>,
+    /// A marks file (`iblkit.marks/1`) whose lines are drawn.
+    pub marks: Option<PathBuf>,
+    /// A room file whose edges are drawn.
+    pub room: Option<PathBuf>,
+}
+
+impl ProbeExtras {
+    /// Whether it asks for nothing.
+    pub fn is_empty(&self) -> bool {
+        *self == ProbeExtras::default()
+    }
+
+    /// The files it reads (checked against the outputs).
+    pub fn inputs(&self) -> Vec<PathBuf> {
+        self.marks.iter().chain(&self.room).cloned().collect()
+    }
+
+    /// Turns `orbit` as asked (angles checked).
+    pub fn aim(&self, orbit: &mut OrbitControl) -> Result<(), ViewerError> {
+        let bad = |what: &str, v: f32, range: &str| {
+            ViewerError::Parameter(format!("{what} {v} degrees: must be {range}"))
+        };
+        if let Some(y) = self.yaw_deg {
+            if !y.is_finite() {
+                return Err(bad("yaw", y, "a finite angle"));
+            }
+            orbit.yaw = y.to_radians().rem_euclid(std::f32::consts::TAU);
+        }
+        if let Some(p) = self.pitch_deg {
+            if !(-89.0..=89.0).contains(&p) {
+                return Err(bad("pitch", p, "-89 to 89"));
+            }
+            orbit.pitch = p.to_radians();
+        }
+        if let Some(f) = self.fov_deg {
+            if !(10.0..=150.0).contains(&f) {
+                return Err(bad("field of view", f, "10 to 150"));
+            }
+            orbit.vertical_fov = f.to_radians();
+        }
+        Ok(())
+    }
+
+    /// Checks the angles and reads the files, for a caller that uses them later (the window).
+    pub fn check(&self) -> Result<(), ViewerError> {
+        let mut orbit = OrbitControl {
+            target: glam::Vec3::ZERO,
+            distance: 0.0,
+            yaw: 0.0,
+            pitch: 0.0,
+            vertical_fov: 1.0,
+        };
+        self.aim(&mut orbit)?;
+        self.overlay().map(|_| ())
+    }
+
+    /// Reads the marks and room files (a bad one is an error naming it) into the overlay;
+    /// `None` when it names neither.
+    pub fn overlay(&self) -> Result<Option<RoomOverlay>, ViewerError> {
+        if self.marks.is_none() && self.room.is_none() {
+            return Ok(None);
+        }
+        let marks = self.marks.as_deref().map(read_marks).transpose()?;
+        let room = self.room.as_deref().map(read_room).transpose()?;
+        Ok(Some(RoomOverlay::new(
+            marks.as_ref(),
+            room.as_ref().map(|r| &r.room),
+        )))
+    }
 }
 
 /// One headless run of `ibl view`.
@@ -230,6 +315,20 @@ impl ViewJob {
 
     /// Runs the job: checks the outputs, renders, writes the last frame, returns the summary.
     pub fn run(&self, progress: &dyn Progress) -> Result<ViewSummary, ViewerError> {
+        self.run_with(&ProbeExtras::default(), progress)
+    }
+
+    /// [`ViewJob::run`] with a probe's camera and room overlays (refused for a scene).
+    pub fn run_with(
+        &self,
+        extras: &ProbeExtras,
+        progress: &dyn Progress,
+    ) -> Result<ViewSummary, ViewerError> {
+        if is_scene(&self.input) && !extras.is_empty() {
+            return Err(ViewerError::Parameter(
+                "--marks, --room, --yaw, --pitch and --fov apply to a probe, not a scene".into(),
+            ));
+        }
         let outputs = self.output.as_deref().map(frame_outputs).transpose()?;
         if !(1..=100_000).contains(&self.frames.frames) {
             return Err(ViewerError::Parameter("frames: must be 1 to 100000".into()));
@@ -250,13 +349,24 @@ impl ViewJob {
             (run?, ViewKind::Scene)
         } else {
             let model = ProbeModel::open(&self.input, self.mapping)?;
-            check_outputs(outputs.as_ref(), std::slice::from_ref(&self.input))?;
-            let settings = self.probe_settings(&model)?;
+            let mut inputs = extras.inputs();
+            inputs.push(self.input.clone());
+            check_outputs(outputs.as_ref(), &inputs)?;
+            let mut settings = self.probe_settings(&model)?;
+            extras.aim(&mut settings.orbit)?;
+            let room = extras.overlay()?;
             let gpu = GpuContext::headless()?;
             progress.begin("frames", frames);
-            let run = headless::render_probe(&gpu, &model, &settings, &options, &|d, t| {
-                progress.update(d as u64, t as u64, None);
-            });
+            let run = headless::render_probe_with(
+                &gpu,
+                &model,
+                &settings,
+                &options,
+                room.as_ref(),
+                &|d, t| {
+                    progress.update(d as u64, t as u64, None);
+                },
+            );
             progress.end();
             (run?, ViewKind::Probe)
         };

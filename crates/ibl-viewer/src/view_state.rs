@@ -20,9 +20,12 @@ use crate::lighting::{
 use crate::probe_model::{ProbeModel, ProbeViewSettings};
 use crate::probe_pass::ProbeProjection;
 use crate::probe_renderer::ProbeRenderer;
+use crate::room_marking::{PendingLine, RoomSession};
+use crate::room_overlay::{OverlayView, perspective_view};
 use crate::scene_model::{DragAction, SceneModel};
 use crate::scene_renderer::{GlossySource, SceneFrameSettings, SceneRenderer};
 use crate::view_camera::{OrbitControl, OutputCamera};
+use crate::view_job::ProbeExtras;
 use crate::worker::LatestWorker;
 
 /// A discrete action from the keyboard.
@@ -34,6 +37,12 @@ pub enum ViewEvent {
     Frame,
     /// Clear the selection.
     Deselect,
+    /// The axis of the next marked line (probe: keys X, Y, Z).
+    MarkAxis(ibl_room::Axis),
+    /// Remove the last marked line (probe: Backspace).
+    DeleteLastLine,
+    /// Switch marking lines on or off (probe: key M).
+    ToggleMarking,
 }
 
 /// The probe viewer's state.
@@ -49,6 +58,8 @@ pub struct ProbeState {
     pub overlay_seconds: f64,
     /// The direction and radiance under the cursor.
     pub cursor: Option<(Vec3, ibl_core::Rgb)>,
+    /// The room tools: the marks being edited and the room shown over the probe.
+    pub room: RoomSession,
 }
 
 /// How the scene camera is placed.
@@ -118,17 +129,24 @@ pub fn default_save_path(scene: &Path) -> PathBuf {
 }
 
 impl Content {
-    /// Opens a probe or a scene file (`.toml`).
+    /// Opens a probe or a scene file (`.toml`); `extras` aims a probe's camera and names the
+    /// marks and room drawn over it (refused for a scene).
     pub fn open(
         gpu: &GpuContext,
         path: &Path,
         mapping: Option<Mapping>,
         size: (u32, u32),
         shadow_tile: u32,
+        extras: &ProbeExtras,
     ) -> Result<Content, ViewerError> {
         let is_scene = path
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
+        if is_scene && !extras.is_empty() {
+            return Err(ViewerError::Parameter(
+                "--marks, --room, --yaw, --pitch and --fov apply to a probe, not a scene".into(),
+            ));
+        }
         if is_scene {
             let model = SceneModel::open(path)?;
             let renderer = SceneRenderer::new(gpu, &model, size.0, size.1, shadow_tile)?;
@@ -167,9 +185,19 @@ impl Content {
             })))
         } else {
             let model = ProbeModel::open(path, mapping)?;
+            let mut settings = ProbeViewSettings::for_probe(&model.latlong);
+            extras.aim(&mut settings.orbit)?;
+            let probe_size = (model.mapping == Mapping::LatLong)
+                .then(|| [model.latlong.width() as u32, model.latlong.height() as u32]);
+            let room = RoomSession::open(
+                path,
+                probe_size,
+                extras.marks.as_deref(),
+                extras.room.as_deref(),
+            )?;
             let renderer = ProbeRenderer::new(gpu, &model, size.0, size.1)?;
-            let settings = ProbeViewSettings::for_probe(&model.latlong);
             Ok(Content::Probe(Box::new(ProbeState {
+                room,
                 model,
                 settings,
                 renderer,
@@ -304,7 +332,9 @@ impl Content {
             Content::Empty => Ok(()),
             Content::Probe(p) => {
                 p.renderer.resize(gpu, size.0, size.1)?;
-                p.renderer.render(gpu, &p.settings, scale);
+                let view = OverlayView::of_settings(&p.settings, size.0, size.1);
+                let segments = p.room.segments(&view, scale);
+                p.renderer.render_with(gpu, &p.settings, scale, &segments);
                 Ok(())
             }
             Content::Scene(s) => {
@@ -338,6 +368,14 @@ impl Content {
             (Content::Probe(p), ViewEvent::Frame) => {
                 p.settings.orbit.yaw = 0.0;
                 p.settings.orbit.pitch = 0.0;
+            }
+            (Content::Probe(p), ViewEvent::MarkAxis(axis)) => p.room.axis = axis,
+            (Content::Probe(p), ViewEvent::DeleteLastLine) => {
+                p.room.delete_last_line();
+            }
+            (Content::Probe(p), ViewEvent::ToggleMarking) => {
+                p.room.marking = !p.room.marking;
+                p.room.pending = None;
             }
             (Content::Scene(s), ViewEvent::Frame) => s.frame_selection(),
             (Content::Scene(s), ViewEvent::Deselect) => s.selected = None,
@@ -415,12 +453,60 @@ fn frame_pixel(pos: egui::Pos2, shown: egui::Rect, size: (u32, u32)) -> Vec2 {
 }
 
 impl ProbeState {
+    /// The frame's size, pixels (the size of the view a line marked now is saved with).
+    pub fn frame_size(&self) -> (u32, u32) {
+        self.renderer.targets().size
+    }
+
+    /// Whether a left-drag marks a line now (marking is on and the view looks around).
+    pub fn marking_lines(&self) -> bool {
+        self.room.marking && self.settings.projection == ProbeProjection::LookAround
+    }
+
+    /// A left-drag while marking: starts, moves and finishes the pending line (in the view the
+    /// drag started in); a refused line's reason is kept in the room tools.
+    fn mark(&mut self, response: &egui::Response, shown: egui::Rect, input: &PointerInput) {
+        let size = self.renderer.targets().size;
+        let at = |p: egui::Pos2| {
+            let px = frame_pixel(p, shown, size);
+            [f64::from(px.x), f64::from(px.y)]
+        };
+        if response.drag_started_by(egui::PointerButton::Primary)
+            && let Some(origin) = input.press_origin.or(response.interact_pointer_pos())
+        {
+            let from = at(origin);
+            self.room.pending = Some(PendingLine {
+                view: perspective_view(&self.settings.orbit, size.0, size.1),
+                axis: self.room.axis,
+                from,
+                to: from,
+            });
+        }
+        if response.dragged_by(egui::PointerButton::Primary)
+            && let (Some(pending), Some(p)) =
+                (self.room.pending.as_mut(), response.interact_pointer_pos())
+        {
+            pending.to = at(p);
+        }
+        if response.drag_stopped_by(egui::PointerButton::Primary)
+            && let Some(p) = self.room.pending.take()
+        {
+            self.room.refused = self.room.add_line(p.view, p.axis, p.from, p.to).err();
+        }
+    }
+
     fn pointer(&mut self, response: &egui::Response, shown: egui::Rect, input: &PointerInput) {
         let size = self.renderer.targets().size;
         let per_pixel = self.settings.orbit.vertical_fov / shown.height().max(1.0);
-        if response.dragged_by(egui::PointerButton::Primary)
-            && self.settings.projection == ProbeProjection::LookAround
-        {
+        // While marking, the left button draws lines and the right one turns the view.
+        let turning = if self.marking_lines() {
+            self.mark(response, shown, input);
+            response.dragged_by(egui::PointerButton::Secondary)
+        } else {
+            self.room.pending = None;
+            response.dragged_by(egui::PointerButton::Primary)
+        };
+        if turning && self.settings.projection == ProbeProjection::LookAround {
             let d = response.drag_delta();
             self.settings.orbit.turn(d.x * per_pixel, d.y * per_pixel);
         }
@@ -654,6 +740,8 @@ pub struct PointerInput {
     pub shift: bool,
     /// Ctrl (Cmd on macOS) held.
     pub ctrl: bool,
+    /// Where the press of the button held down began, points.
+    pub press_origin: Option<egui::Pos2>,
 }
 
 impl PointerInput {
@@ -663,6 +751,7 @@ impl PointerInput {
             scroll: input.smooth_scroll_delta.y,
             shift: input.modifiers.shift,
             ctrl: input.modifiers.command,
+            press_origin: input.pointer.press_origin(),
         }
     }
 }

@@ -13,6 +13,11 @@
 //! zooms (field of view in the probe viewer, distance in the scene viewer). Keys: 1-6 look along
 //! +X -X +Y -Y +Z -Z (probe), F frames the selection, F11 full screen, F12 saves the frame as EXR
 //! and PNG, Ctrl+S saves the scene, Esc deselects. Files dropped onto the window are opened.
+//!
+//! Room tools (probe, the side panel's "Room" section, [`crate::room_marking`]): M switches
+//! marking lines on and off; while on, a left-drag draws a line (right-drag turns the view), X, Y
+//! and Z choose the axis of the next line and Backspace removes the last one. Keys are ignored
+//! while a text field has the focus.
 
 use std::path::{Path, PathBuf};
 use std::sync::mpsc::{Receiver, channel};
@@ -25,6 +30,7 @@ use ibl_mapping::Mapping;
 use crate::ViewerError;
 use crate::gpu::GpuContext;
 use crate::panels;
+use crate::view_job::ProbeExtras;
 use crate::view_state::{Content, PointerInput, ViewEvent};
 
 /// How the window starts.
@@ -40,6 +46,8 @@ pub struct WindowOptions {
     pub screenshot: Option<PathBuf>,
     /// Shadow map side per light, texels.
     pub shadow_tile: u32,
+    /// The camera and the room overlays of the probe opened first (`--yaw`, `--marks`, ...).
+    pub probe: ProbeExtras,
 }
 
 /// Opens the window and runs it until it is closed.
@@ -139,14 +147,26 @@ impl ViewerApp {
             frames_drawn: 0,
         };
         if let Some(input) = options.input {
-            app.open(&input);
+            app.open_with(&input, &options.probe);
         }
         app
     }
 
     /// Opens a probe or scene file; on failure the error is shown and the content kept.
     pub fn open(&mut self, path: &Path) {
-        let opened = Content::open(&self.gpu, path, self.mapping, (640, 480), self.shadow_tile);
+        self.open_with(path, &ProbeExtras::default());
+    }
+
+    /// [`ViewerApp::open`] with a probe's camera and room overlays.
+    pub fn open_with(&mut self, path: &Path, extras: &ProbeExtras) {
+        let opened = Content::open(
+            &self.gpu,
+            path,
+            self.mapping,
+            (640, 480),
+            self.shadow_tile,
+            extras,
+        );
         let opened = opened.and_then(|c| self.gpu.take_errors().map(|()| c));
         match opened {
             Ok(content) => {
@@ -192,9 +212,15 @@ impl ViewerApp {
     }
 
     fn keys(&mut self, ctx: &egui::Context) {
+        let typing = ctx.text_edit_focused();
         let (fullscreen, save_frame, save_scene, events) = ctx.input(|i| {
             let mut events = Vec::new();
             for (key, event) in [
+                (egui::Key::X, ViewEvent::MarkAxis(ibl_room::Axis::X)),
+                (egui::Key::Y, ViewEvent::MarkAxis(ibl_room::Axis::Y)),
+                (egui::Key::Z, ViewEvent::MarkAxis(ibl_room::Axis::Z)),
+                (egui::Key::M, ViewEvent::ToggleMarking),
+                (egui::Key::Backspace, ViewEvent::DeleteLastLine),
                 (egui::Key::Num1, ViewEvent::Axis(0)),
                 (egui::Key::Num2, ViewEvent::Axis(1)),
                 (egui::Key::Num3, ViewEvent::Axis(2)),
@@ -204,7 +230,7 @@ impl ViewerApp {
                 (egui::Key::F, ViewEvent::Frame),
                 (egui::Key::Escape, ViewEvent::Deselect),
             ] {
-                if i.key_pressed(key) && !i.modifiers.any() {
+                if !typing && i.key_pressed(key) && !i.modifiers.any() {
                     events.push(event);
                 }
             }

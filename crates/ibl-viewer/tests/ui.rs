@@ -1,20 +1,32 @@
 //! The window's UI without a display (egui_kittest driving the real eframe application on the
 //! viewer's own device): a scene opens, its lights arrive from the worker, the panel's controls
-//! change the scene, the frame shows the scene, and a bad file is reported in the window.
+//! change the scene, the frame shows the scene, a bad file is reported in the window, and the
+//! room tools mark, remove and calibrate lines over a probe.
 
 mod common;
 
 use std::time::{Duration, Instant};
 
+use eframe::egui;
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use ibl_scene::RenderMode;
-use ibl_viewer::view_state::Content;
+use ibl_viewer::ProbeExtras;
+use ibl_viewer::view_state::{Content, ProbeState};
 use ibl_viewer::window::{ViewerApp, WindowOptions};
 
 fn harness(
     gpu: &ibl_viewer::GpuContext,
     input: Option<std::path::PathBuf>,
+) -> Harness<'static, ViewerApp> {
+    harness_with(gpu, input, ProbeExtras::default(), 520.0)
+}
+
+fn harness_with(
+    gpu: &ibl_viewer::GpuContext,
+    input: Option<std::path::PathBuf>,
+    probe: ProbeExtras,
+    height: f32,
 ) -> Harness<'static, ViewerApp> {
     let app = ViewerApp::new(
         gpu.clone(),
@@ -24,11 +36,12 @@ fn harness(
             size: (600, 450),
             screenshot: None,
             shadow_tile: 512,
+            probe,
         },
         Default::default(),
     );
     Harness::builder()
-        .with_size(eframe::egui::vec2(900.0, 520.0))
+        .with_size(eframe::egui::vec2(900.0, height))
         .build_ui_state(|ui, app: &mut ViewerApp| app.show(ui, None), app)
 }
 
@@ -102,4 +115,98 @@ fn a_bad_file_is_reported_in_the_window() {
     assert!(error.contains("broken.toml"), "{error}");
     assert!(matches!(h.state().content, Content::Empty));
     h.get_by_label_contains("broken.toml");
+}
+
+fn probe(app: &ViewerApp) -> &ProbeState {
+    match &app.content {
+        Content::Probe(p) => p,
+        _ => panic!("a probe is open: {:?}", app.error),
+    }
+}
+
+#[test]
+fn the_room_tools_mark_a_line_remove_it_and_calibrate() {
+    let Some(gpu) = common::gpu_or_skip("ui room") else {
+        return;
+    };
+    let apartment = common::assets().join("rooms/apartment");
+    let mut h = harness_with(
+        &gpu,
+        Some(common::assets().join("probes/apartment.exr")),
+        ProbeExtras {
+            yaw_deg: Some(20.0),
+            marks: Some(apartment.join("marks.json")),
+            room: Some(apartment.join("room.toml")),
+            ..ProbeExtras::default()
+        },
+        // Tall enough for the side panel's Room section to show without scrolling.
+        1400.0,
+    );
+    h.step();
+    assert_eq!(probe(h.state()).room.line_count(), 13);
+    assert_eq!(probe(h.state()).room.room_edges(), 28);
+    // M switches marking on; Y picks the axis; a left-drag in the view draws a line.
+    h.key_press(egui::Key::M);
+    h.key_press(egui::Key::Y);
+    h.step();
+    assert!(probe(h.state()).marking_lines());
+    let (from, to) = (egui::pos2(200.0, 150.0), egui::pos2(230.0, 320.0));
+    h.hover_at(from);
+    h.step();
+    h.drag_at(from);
+    h.step();
+    for k in 1..=6 {
+        h.hover_at(from + (to - from) * (k as f32 / 6.0));
+        h.step();
+    }
+    h.drop_at(to);
+    h.step();
+    h.step();
+    let p = probe(h.state());
+    assert_eq!(p.room.line_count(), 14, "{:?}", p.room.refused);
+    let view = p.room.marks.views.last().expect("a view of the camera");
+    assert_eq!(view.lines[0].axis, ibl_room::Axis::Y);
+    // The view is the camera that showed the line, at the frame's pixel size.
+    assert!(
+        (view.camera.yaw_deg - 20.0).abs() < 1e-4,
+        "{:?}",
+        view.camera
+    );
+    assert!((view.camera.vertical_fov_deg - 75.0).abs() < 1e-4);
+    let size = p.frame_size();
+    assert_eq!((view.camera.width, view.camera.height), size);
+    assert!(
+        view.name.starts_with("yaw 20.0 pitch 0.0 fov 75.0"),
+        "{}",
+        view.name
+    );
+    // Points map to frame pixels one to one (1 pixel per point): the segment is the drag, from
+    // the press; the frame starts where the harness's root panel's margin leaves it (8 points).
+    let line = view.lines[0];
+    let (dx, dy) = (line.to[0] - line.from[0], line.to[1] - line.from[1]);
+    assert!(
+        (dx - 30.0).abs() < 0.5 && (dy - 170.0).abs() < 0.5,
+        "{line:?}"
+    );
+    let offset = (200.0 - line.from[0], 150.0 - line.from[1]);
+    assert!(
+        (0.0..=10.0).contains(&offset.0) && (0.0..=10.0).contains(&offset.1),
+        "{line:?}"
+    );
+    // Calibrate: 14 lines, each with its residual shown.
+    h.get_by_label("calibrate").click();
+    h.step();
+    let c = probe(h.state())
+        .room
+        .calibration
+        .clone()
+        .expect("ran")
+        .expect("calibrates");
+    assert_eq!(c.lines.len(), 14);
+    h.get_by_label_contains("14 lines: rotation");
+    // Backspace removes the new line (and its view).
+    h.key_press(egui::Key::Backspace);
+    h.step();
+    assert_eq!(probe(h.state()).room.line_count(), 13);
+    assert!(probe(h.state()).room.calibration.is_none());
 }
