@@ -1,6 +1,8 @@
 //! Why a room operation failed, split by cause; [`RoomError::is_bad_input`] tells a front end
 //! whether the input is at fault (exit status 2) or something went wrong inside (exit status 1).
 
+use ibl_scene::description::DescriptionError;
+
 /// Why a room operation failed.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum RoomError {
@@ -25,6 +27,17 @@ pub enum RoomError {
     /// An internal numerical failure (a degenerate system that valid input cannot produce).
     #[error("numerical failure: {0}")]
     Numerical(String),
+}
+
+/// A scene format error (the `[room]` table's checks, a room file parsed as a scene): the same
+/// field and message, bad input.
+impl From<DescriptionError> for RoomError {
+    fn from(e: DescriptionError) -> RoomError {
+        RoomError::Invalid {
+            field: e.field,
+            problem: e.problem,
+        }
+    }
 }
 
 impl RoomError {

@@ -15,7 +15,7 @@ use glam::{Vec2, Vec3};
 
 use crate::RoomError;
 use crate::description::{BoxFace, Facing, RoomDescription};
-use crate::polygon::{polygon_frame, signed_area};
+use ibl_scene::polygon::{polygon_frame, signed_area};
 
 /// A planar face of the room.
 #[derive(Clone, Debug, PartialEq)]

@@ -6,7 +6,8 @@
 //! World frame and units as `docs/CONVENTIONS.md` (+Y up, -Z forward, +X right; metres; radiance
 //! in the probe's units, radiosity `B = pi L`). The method and a worked example: `docs/ROOMS.md`.
 //!
-//! - [`description`]: the `[room]` table (groups, rectangles, boxes, polygons), validated.
+//! - [`description`]: the room file (`[probe]` and `[room]`, parsed as a scene); the `[room]`
+//!   table's types (groups, rectangles, boxes, polygons) are `ibl-scene`'s, re-exported.
 //! - [`geometry`]: planar faces with their frames; [`patches`]: subdivision by area (3.3).
 //! - [`room`]: the resolved room with its BVH and the placed probe.
 //! - [`depth_map`]: the omnidirectional depth map from the probe centre (3.2, Fig. 5).
@@ -37,7 +38,6 @@ pub mod observation;
 pub mod patches;
 pub mod picture;
 pub mod placement;
-mod polygon;
 pub mod radiosity;
 pub mod reflectance;
 pub mod report;

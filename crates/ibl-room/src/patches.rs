@@ -17,7 +17,7 @@ use glam::{Vec2, Vec3};
 
 use crate::RoomError;
 use crate::geometry::{Face, FaceShape};
-use crate::polygon::signed_area;
+use ibl_scene::polygon::signed_area;
 
 /// Largest number of patches a room may be cut into.
 pub const MAX_PATCHES: usize = 500_000;

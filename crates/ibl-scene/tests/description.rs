@@ -7,7 +7,9 @@
 use std::path::PathBuf;
 
 use glam::Vec3;
-use ibl_scene::description::{CompositeRule, MaterialKind, ShapeKind};
+use ibl_scene::description::{
+    CompositeRule, GroupKind, MaterialKind, RectangleDescription, ShapeKind,
+};
 use ibl_scene::{DescriptionError, RenderMode, SceneDescription};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
@@ -777,5 +779,85 @@ fn the_outdoor_example_in_the_user_documentation_parses() {
     assert_eq!(
         o.frames.start_local_time().unwrap(),
         (2024, 4, 20, 11, 0, 0.0)
+    );
+}
+
+fn room_file(name: &str) -> String {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../assets/rooms")
+        .join(name)
+        .join("room.toml");
+    std::fs::read_to_string(&path).unwrap()
+}
+
+#[test]
+fn the_bundled_room_files_are_scenes_with_a_room() {
+    for name in ["apartment", "synthetic"] {
+        let d = SceneDescription::from_toml(&room_file(name)).unwrap();
+        let room = d.room.as_ref().unwrap_or_else(|| panic!("{name}: no room"));
+        assert!(!room.groups.is_empty() && !room.boxes.is_empty(), "{name}");
+        // A room file has no objects: rendered, it is the probe.
+        assert!(d.object.is_empty() && d.local.is_empty(), "{name}");
+    }
+    // The synthetic room's first surface group, as the file gives it.
+    let d = SceneDescription::from_toml(&room_file("synthetic")).unwrap();
+    let room = d.room.unwrap();
+    assert_eq!(room.groups[0].name, "wall");
+    assert_eq!(room.groups[0].kind, GroupKind::Surface);
+    assert!(room.groups.iter().any(|g| g.kind == GroupKind::Light));
+    // Without a `[room]`, a scene has none.
+    assert!(SceneDescription::from_toml(BASE).unwrap().room.is_none());
+}
+
+#[test]
+fn a_bad_room_field_is_refused_naming_it() {
+    let text = room_file("synthetic");
+    assert!(text.contains("patch_area_m2 = 0.05"));
+    refused(
+        &text.replace("patch_area_m2 = 0.05", "patch_area_m2 = 0.0"),
+        "room.patch_area_m2",
+        "is not in",
+    );
+    refused(
+        &text.replace("patch_area_m2 = 0.05", "patch_area_m2 = \"big\""),
+        "room.patch_area_m2",
+        "invalid type",
+    );
+    refused(
+        &text.replacen("name = \"wall\"", "name = \"floor\"", 1),
+        "room.group[1].name",
+        "defined twice",
+    );
+    refused(
+        &format!("{BASE}\n[room]\n[[room.group]]\nname = \"wall\"\n"),
+        "room",
+        "at least one rectangle, box or polygon",
+    );
+    refused(
+        &format!(
+            "{BASE}\n[room]\n[[room.group]]\nname = \"wall\"\n[[room.box]]\nmin = [0.0, 0.0, 0.0]\nmax = [1.0, 1.0, 1.0]\ngroup = \"wall\"\nopenings = [{{ face = \"-z\", min = [0.2, 0.2], max = [0.4, 1.5] }}]\n"
+        ),
+        "room.box[0].openings[0].max",
+        "outside the surface",
+    );
+    // Built in code: the same checks through `SceneDescription::validate`.
+    let mut d = SceneDescription::from_toml(&text).unwrap();
+    d.room
+        .as_mut()
+        .unwrap()
+        .rectangles
+        .push(RectangleDescription {
+            name: None,
+            group: "walls".into(),
+            corner: [0.0; 3],
+            edge_u: [1.0, 0.0, 0.0],
+            edge_v: [0.0, 1.0, 0.0],
+            holes: Vec::new(),
+        });
+    let e = d.validate().unwrap_err();
+    assert_eq!(e.field, "room.rectangle[0].group", "{e}");
+    assert!(
+        e.problem.contains("no [[room.group]] is named `walls`"),
+        "{e}"
     );
 }

@@ -7,13 +7,15 @@
 //! (`[[local]]`: planes, boxes, spheres and meshes with a diffuse albedo per material group: the real
 //! surfaces near the virtual objects, Debevec 1998's "local scene"), **virtual objects**
 //! (`[[object]]`: meshes or shapes with a transform and a material), the renderer's settings
-//! (`[render]`), the lighting (`[lighting]`) and, for outdoor AR under changing light (Jensen,
-//! Andersen & Madsen 2006), the site, times, mask and video frames (`[outdoor]`).
+//! (`[render]`), the lighting (`[lighting]`), for outdoor AR under changing light (Jensen,
+//! Andersen & Madsen 2006), the site, times, mask and video frames (`[outdoor]`) and, for Grosch
+//! 2005's room reconstruction, the room's surfaces and material groups (`[room]`: a **room file**
+//! is a scene with a `[probe]` and a `[room]`, what `ibl room` reads and writes).
 //!
 //! One module per table of the file ([`ProbeDescription`] in `probe`, `background`, `camera`,
-//! `geometry` for `[[local]]` and `[[object]]`, `material`, `render`, `lighting`, `outdoor`); this
-//! module holds the whole file and the checks that span tables (a photo background needs a camera,
-//! an outdoor scene a camera and a photo background, ...).
+//! `geometry` for `[[local]]` and `[[object]]`, `material`, `render`, `lighting`, `outdoor`,
+//! `room`); this module holds the whole file and the checks that span tables (a photo background
+//! needs a camera, an outdoor scene a camera and a photo background, ...).
 //!
 //! Parsing refuses unknown fields (a typo is an error, not a silently ignored setting). After
 //! parsing, [`SceneDescription::validate`] checks every value and names the offending field by its
@@ -29,6 +31,7 @@ mod material;
 mod outdoor;
 mod probe;
 mod render;
+mod room;
 mod toml_error;
 
 use serde::{Deserialize, Serialize};
@@ -51,6 +54,11 @@ pub use outdoor::{
 pub use probe::ProbeDescription;
 pub use render::{
     CompositeRule, MAX_BOUNCES, MAX_SPP, MAX_WIDTH, RenderDescription, RenderMode, SamplerKind,
+};
+pub use room::{
+    BoxDescription, BoxFace, Facing, GroupDescription, GroupKind, HoleDescription,
+    MAX_COORDINATE_M, MAX_PATCH_AREA_M2, MAX_POLYGON_VERTICES, MAX_SURFACES, MIN_PATCH_AREA_M2,
+    OpeningDescription, PolygonDescription, RectangleDescription, RoomDescription,
 };
 
 /// The only format version this build reads.
@@ -87,6 +95,12 @@ pub struct SceneDescription {
     /// scene. With it, `camera` is the video camera and `background` a representative frame.
     #[serde(default)]
     pub outdoor: Option<OutdoorDescription>,
+    /// The room of Grosch 2005 (`ibl room`): its surfaces, material groups and patch size, with
+    /// the probe placed in it by `[probe]`. Default none. A room file is a scene with only
+    /// `[probe]` and `[room]`; the renderer does not draw the room (it is the real scene the probe
+    /// shows).
+    #[serde(default)]
+    pub room: Option<RoomDescription>,
 }
 
 impl SceneDescription {
@@ -187,6 +201,9 @@ impl SceneDescription {
         self.lighting.validate()?;
         if let Some(outdoor) = &self.outdoor {
             outdoor.validate()?;
+        }
+        if let Some(room) = &self.room {
+            room.validate()?;
         }
         Ok(())
     }

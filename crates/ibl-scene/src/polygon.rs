@@ -1,12 +1,12 @@
 //! Planar polygons in their own frame: the signed area of a ring in `(u, v)` metres and the frame
 //! of a polygon given by its 3-D vertices (Newell's normal, the first edge as `u`, planarity and
-//! simplicity checked). A leaf module: the room description validates polygons with it and the
-//! face builder (`geometry`) lays them out, so neither imports the other.
+//! simplicity checked). A leaf module: the `[room]` table's validation (`description`) refuses
+//! polygons with it and `ibl-room`'s face builder lays them out with it.
 
 use glam::{Vec2, Vec3};
 
-/// Twice the signed area's half: the signed area of a 2D polygon (positive counter-clockwise).
-pub(crate) fn signed_area(points: &[Vec2]) -> f32 {
+/// The signed area of a 2D polygon (positive counter-clockwise).
+pub fn signed_area(points: &[Vec2]) -> f32 {
     let n = points.len();
     0.5 * (0..n)
         .map(|i| points[i].perp_dot(points[(i + 1) % n]))
@@ -18,9 +18,7 @@ pub(crate) fn signed_area(points: &[Vec2]) -> f32 {
 /// counter-clockwise seen from the front), and the vertices in `(u, v)` metres. Refuses
 /// polygons out of plane by more than 1 mm plus 1e-4 of their size, with no area, or whose edges
 /// cross.
-pub(crate) fn polygon_frame(
-    vertices: &[[f32; 3]],
-) -> Result<(Vec3, Vec3, Vec3, Vec3, Vec<Vec2>), String> {
+pub fn polygon_frame(vertices: &[[f32; 3]]) -> Result<(Vec3, Vec3, Vec3, Vec3, Vec<Vec2>), String> {
     let p: Vec<Vec3> = vertices.iter().map(|&v| Vec3::from(v)).collect();
     let n = p.len();
     // Newell's method: robust for any simple planar polygon.
