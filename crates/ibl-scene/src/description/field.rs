@@ -27,8 +27,13 @@ pub(crate) fn finite3(field: &str, v: [f32; 3]) -> Result<(), DescriptionError> 
     }
 }
 
-pub(crate) fn positive(field: &str, v: f32) -> Result<(), DescriptionError> {
-    if v.is_finite() && v > 0.0 {
+/// `v` (an `f32` or `f64` field) finite and > 0, or an error at `field`.
+pub(crate) fn positive<T: Into<f64> + Copy + std::fmt::Display>(
+    field: &str,
+    v: T,
+) -> Result<(), DescriptionError> {
+    let x: f64 = v.into();
+    if x.is_finite() && x > 0.0 {
         Ok(())
     } else {
         Err(invalid(

@@ -22,7 +22,7 @@ use glam::{DVec3, Vec3};
 use serde::{Deserialize, Serialize};
 use toml::value::Datetime;
 
-use super::field::{DescriptionError, invalid};
+use super::field::{DescriptionError, invalid, positive};
 
 /// Default world direction of geographic north: -Z (so east, `north x up`, is +X).
 pub const DEFAULT_NORTH: [f32; 3] = [0.0, 0.0, -1.0];
@@ -181,18 +181,6 @@ fn within(field: &str, v: f64, lo: f64, hi: f64, unit: &str) -> Result<(), Descr
     }
 }
 
-/// `v` finite and > 0, or an error at `field`.
-fn positive_f64(field: &str, v: f64) -> Result<(), DescriptionError> {
-    if v.is_finite() && v > 0.0 {
-        Ok(())
-    } else {
-        Err(invalid(
-            field,
-            format!("{v} is not a positive finite number"),
-        ))
-    }
-}
-
 fn nonempty(field: &str, path: &Path) -> Result<(), DescriptionError> {
     if path.as_os_str().is_empty() {
         Err(invalid(field, "is an empty path"))
@@ -259,7 +247,7 @@ impl OutdoorDescription {
             ));
         }
         if let Some(spacing) = self.volume_spacing_m {
-            positive_f64("outdoor.volume_spacing_m", spacing)?;
+            positive("outdoor.volume_spacing_m", spacing)?;
         }
         self.frames.validate()
     }
@@ -309,7 +297,7 @@ impl FramesDescription {
     fn validate(&self) -> Result<(), DescriptionError> {
         nonempty("outdoor.frames.source", &self.source)?;
         local_civil_time("outdoor.frames.start", &self.start)?;
-        positive_f64("outdoor.frames.interval_s", self.interval_s)
+        positive("outdoor.frames.interval_s", self.interval_s)
     }
 
     /// The local civil time of the first frame, at `outdoor.utc_offset_hours`.
