@@ -16,11 +16,14 @@ use crate::progress::Bars;
 Per frame: the sun's and the sky's RGB (P_d, P_a) from about 500 pixels of the marked diffuse
 surfaces, the environment map relit to match, and the scene's [[object]]s composited into the
 frame with the sun's shadows both ways. Outputs: estimates.csv, estimates.json, estimates.svg,
-composites/NAME.exr and .png (one exposure for the whole sequence), relit/NAME.exr (--relit).
+composites/NAME.exr and .png (one exposure for the whole sequence), relit/NAME.exr (--relit),
+a video of the composites (--video, through ffmpeg). The frames are a folder of images or a
+video file (decoded by ffmpeg; its sRGB values are made linear).
 
 Examples:
   ibl outdoor assets/outdoor/courtyard/scene.toml --out courtyard
   ibl outdoor scene.toml --out run --frames 10 --spp 64 --relit
+  ibl outdoor scene.toml --out run --video run/composites.mp4 --video-fps 2
   ibl outdoor scene.toml --out run --no-composites --json > run.json")]
 pub struct OutdoorArgs {
     /// Scene file with an [outdoor] table (docs/SCENES.md).
@@ -40,6 +43,12 @@ pub struct OutdoorArgs {
     /// Also write each frame's relit environment map.
     #[arg(long)]
     relit: bool,
+    /// Also write the composites as a video (through ffmpeg; .mp4, .mkv, ...).
+    #[arg(long, value_name = "FILE")]
+    video: Option<PathBuf>,
+    /// Frame rate of --video.
+    #[arg(long, value_name = "FPS", default_value_t = ibl_pipeline::outdoor::DEFAULT_VIDEO_FPS)]
+    video_fps: f64,
     /// Print the whole summary as JSON on stdout.
     #[arg(long)]
     json: bool,
@@ -52,6 +61,8 @@ pub fn run(args: &OutdoorArgs) -> anyhow::Result<()> {
     job.relit_maps = args.relit;
     job.composite.spp = args.spp;
     job.max_frames = args.frames.map(|n| n as usize);
+    job.video = args.video.clone();
+    job.video_fps = args.video_fps;
     let summary = run_outdoor(&job, &Bars::default())?;
     if args.json {
         println!("{}", serde_json::to_string_pretty(&summary)?);

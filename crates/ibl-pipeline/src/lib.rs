@@ -19,7 +19,8 @@
 //!   2005 (marks to frame and scale, room and probe to reflectance and the report, the important
 //!   patches as an area-light file), on [`room_input`];
 //! - [`outdoor`]: outdoor AR under changing light (Jensen, Andersen & Madsen 2006): per-frame
-//!   sun and sky estimates, relit maps and composites of a frame sequence;
+//!   sun and sky estimates, relit maps and composites of a frame sequence; [`video`]: video in
+//!   and out through ffmpeg;
 //! - [`capture`]: brackets merged to HDR ([`exposure_list`]: the time files it reads);
 //!   [`capture_views`]: mirror balls and fisheye pairs;
 //! - [`demo`]: the main job on the bundled probes and scenes ([`demo_probe`], [`demo_render`],
@@ -65,6 +66,7 @@ pub mod room_estimate;
 pub mod room_input;
 pub mod room_lights;
 pub mod sh;
+pub mod video;
 
 pub use envmap_files::EnvMapping;
 pub use error::{PipelineError, Result};

@@ -14,7 +14,7 @@ use std::time::Instant;
 
 use glam::Vec3;
 use ibl_core::Image;
-use ibl_core::tonemap::{Display, auto_exposure_stops};
+use ibl_core::tonemap::{Display, auto_exposure_stops, to_srgb8};
 use ibl_io::WriteOptions;
 use ibl_outdoor::plot::{SeriesPoint, estimates_svg};
 use ibl_outdoor::{
@@ -27,8 +27,9 @@ use ibl_sh::VolumeGrid;
 use serde::Serialize;
 
 use crate::error::{Context, PipelineError, Result};
-use crate::output_paths::check_output_folder;
+use crate::output_paths::{check_output_folder, check_output_path};
 use crate::progress::Progress;
+use crate::video::{VideoReader, VideoWriter};
 
 /// Frame file extensions read from the frames folder (case-insensitive).
 pub const FRAME_EXTENSIONS: [&str; 6] = ["exr", "hdr", "pfm", "png", "jpg", "jpeg"];
@@ -38,6 +39,8 @@ pub const MAX_FRAMES: usize = 100_000;
 const CHART_SIZE: (u32, u32) = (900, 620);
 /// Key-point directions of the irradiance volume (width of each point's lat-long).
 const VOLUME_DIRECTIONS: usize = 32;
+/// Frame rate of the output video unless asked otherwise.
+pub const DEFAULT_VIDEO_FPS: f64 = 10.0;
 /// Margin of the volume's box around the objects, metres.
 const VOLUME_MARGIN_M: f64 = 1.0;
 
@@ -56,6 +59,11 @@ pub struct OutdoorJob {
     pub composite: CompositeSettings,
     /// Process at most this many frames (from the first).
     pub max_frames: Option<usize>,
+    /// Also write the composites (or the frames, without composites) as a video (through
+    /// `ffmpeg`, the container from the extension) at `video_fps` frames per second.
+    pub video: Option<PathBuf>,
+    /// Frame rate of `video`.
+    pub video_fps: f64,
 }
 
 impl OutdoorJob {
@@ -68,6 +76,8 @@ impl OutdoorJob {
             relit_maps: false,
             composite: CompositeSettings::default(),
             max_frames: None,
+            video: None,
+            video_fps: DEFAULT_VIDEO_FPS,
         }
     }
 }
@@ -77,7 +87,9 @@ impl OutdoorJob {
 pub struct OutdoorFrame {
     /// Index in the sequence.
     pub index: usize,
-    /// The frame file.
+    /// The name of its outputs (the file's stem, or `frame_NNNNN` of a video).
+    pub name: String,
+    /// The frame file (or the video it came from).
     pub file: PathBuf,
     /// Local time `YYYY-MM-DDTHH:MM:SS`.
     pub local_time: String,
@@ -110,6 +122,8 @@ pub struct OutdoorSummary {
     pub setup_seconds: f64,
     /// Sample sites drawn on the marked surfaces.
     pub sample_sites: usize,
+    /// The video written (`--video`), as given.
+    pub video: Option<PathBuf>,
     /// The per-frame table, the summary and the chart, relative to the output folder.
     pub csv: PathBuf,
     /// See `csv`.
@@ -129,10 +143,22 @@ pub fn run_outdoor(job: &OutdoorJob, progress: &dyn Progress) -> Result<OutdoorS
         ))
     })?;
     let base = job.scene.parent().unwrap_or(Path::new("."));
-    let frames_dir = base.join(&outdoor.frames.source);
-    let frame_files = list_frames(&frames_dir, job.max_frames)?;
+    let source_path = base.join(&outdoor.frames.source);
+    if !(job.video_fps.is_finite() && job.video_fps > 0.0 && job.video_fps <= 1000.0) {
+        return Err(PipelineError::parameter(format!(
+            "--video-fps {}: not in (0, 1000]",
+            job.video_fps
+        )));
+    }
+    let (frame_files, mut reader) = if source_path.is_file() {
+        (Vec::new(), Some(VideoReader::open(&source_path)?))
+    } else {
+        (list_frames(&source_path, job.max_frames)?, None)
+    };
     let mask_path = base.join(&outdoor.mask);
-    check_outputs(job, &loaded.inputs, &frame_files, &mask_path)?;
+    let mut scene_inputs = loaded.inputs.clone();
+    scene_inputs.push(source_path.clone());
+    check_outputs(job, &scene_inputs, &frame_files, &mask_path)?;
     let location = location(&outdoor);
     let probe_time = timestamp(&outdoor.probe_local_time()?, outdoor.utc_offset_hours)
         .context(format!("{scene_shown}: outdoor.probe_time"))?;
@@ -143,6 +169,18 @@ pub fn run_outdoor(job: &OutdoorJob, progress: &dyn Progress) -> Result<OutdoorS
     .context(format!("{scene_shown}: outdoor.frames.start"))?;
     let start_hour = civil_hour(&outdoor.frames.start_local_time()?);
     let mask = read_mask(&mask_path)?;
+    if let Some(r) = &reader {
+        let (w, h) = r.size();
+        if (w as usize, h as usize) != (mask.width(), mask.height()) {
+            return Err(PipelineError::parameter(format!(
+                "{}: {w} x {h} frames, but the mask {} is {} x {}: frames and mask must be the same size",
+                source_path.display(),
+                mask_path.display(),
+                mask.width(),
+                mask.height()
+            )));
+        }
+    }
 
     let scene = &loaded.scene;
     let settings = system_settings(&outdoor, scene)?;
@@ -150,14 +188,15 @@ pub fn run_outdoor(job: &OutdoorJob, progress: &dyn Progress) -> Result<OutdoorS
     // frame is skipped with a note, and a sequence with no daylight frame is refused before the
     // offline step.
     let start_civil = outdoor.frames.start_local_time()?;
-    let mut timed = Vec::with_capacity(frame_files.len());
-    for index in 0..frame_files.len() {
-        let after = outdoor.frames.seconds_after_start(index);
-        let time = start.plus_seconds(after);
-        let daylight = location.sun_direction(time, settings.delta_t)?.y > 0.0;
-        timed.push((after, time, local_time_label(&start_civil, after), daylight));
-    }
-    if !timed.iter().any(|t| t.3) {
+    let daylight = |index: usize| -> Result<bool> {
+        let time = start.plus_seconds(outdoor.frames.seconds_after_start(index));
+        Ok(location.sun_direction(time, settings.delta_t)?.y > 0.0)
+    };
+    // A video's length is not known before it is decoded: its frames are checked one by one.
+    let any_daylight = reader.is_some()
+        || (0..frame_files.len())
+            .try_fold(false, |any, i| Ok::<_, PipelineError>(any || daylight(i)?))?;
+    if !any_daylight {
         return Err(PipelineError::parameter(format!(
             "{scene_shown}: the sun is below the horizon at every frame's time, so every frame would be skipped (check outdoor.frames.start and utc_offset_hours)"
         )));
@@ -206,22 +245,51 @@ pub fn run_outdoor(job: &OutdoorJob, progress: &dyn Progress) -> Result<OutdoorS
             ibl_io::create_dir_all(&job.out_dir.join(dir))?;
         }
     }
-    progress.begin("outdoor: frames", frame_files.len() as u64);
+    let total = if reader.is_some() {
+        job.max_frames.unwrap_or(0)
+    } else {
+        frame_files.len()
+    } as u64;
+    progress.begin("outdoor: frames", total);
     let mut frames = Vec::with_capacity(frame_files.len());
     let mut display: Option<WriteOptions> = None;
+    let mut writer: Option<VideoWriter> = None;
     let mut skipped = Vec::new();
-    for (index, (path, (after, time, local_time, daylight))) in
-        frame_files.iter().zip(timed).enumerate()
-    {
-        if !daylight {
+    for index in 0.. {
+        if job.max_frames.is_some_and(|m| index >= m) {
+            break;
+        }
+        // The next frame: a file of the folder (read below, once it is known to be needed) or
+        // the video's next frame.
+        let (path, name, decoded) = match reader.as_mut() {
+            Some(r) => match r.next_frame()? {
+                Some(image) => (
+                    source_path.clone(),
+                    format!("frame_{index:05}"),
+                    Some(image),
+                ),
+                None => break,
+            },
+            None => match frame_files.get(index) {
+                Some(p) => (p.clone(), frame_name(p, index), None),
+                None => break,
+            },
+        };
+        let after = outdoor.frames.seconds_after_start(index);
+        let time = start.plus_seconds(after);
+        let local_time = local_time_label(&start_civil, after);
+        if !daylight(index)? {
             progress.note(&format!(
-                "{}: the sun is below the horizon at {local_time}: skipped",
+                "{} ({name}): the sun is below the horizon at {local_time}: skipped",
                 path.display()
             ));
             skipped.push(path.clone());
             continue;
         }
-        let frame = ibl_io::read_image(path)?.image;
+        let frame = match decoded {
+            Some(image) => image,
+            None => ibl_io::read_image(&path)?.image,
+        };
         if (frame.width(), frame.height()) != (mask.width(), mask.height()) {
             return Err(PipelineError::parameter(format!(
                 "{}: {} x {} pixels, but the mask {} is {} x {}: frames and mask must be the same size",
@@ -238,19 +306,18 @@ pub fn run_outdoor(job: &OutdoorJob, progress: &dyn Progress) -> Result<OutdoorS
             .process(time, &frame)
             .context(path.display().to_string())?;
         let estimate_seconds = t0.elapsed().as_secs_f64();
-        let name = frame_name(path, index);
         let t1 = Instant::now();
-        let composite = match &compositor {
+        let options = display.get_or_insert_with(|| WriteOptions {
+            display: Display {
+                exposure_stops: auto_exposure_stops(&frame),
+                ..Display::default()
+            },
+            ..WriteOptions::default()
+        });
+        let (composite, shown) = match &compositor {
             Some(c) => {
                 let lighting = system.frame_lighting(&result)?;
                 let out = c.composite(&frame, &lighting)?;
-                let options = display.get_or_insert_with(|| WriteOptions {
-                    display: Display {
-                        exposure_stops: auto_exposure_stops(&frame),
-                        ..Display::default()
-                    },
-                    ..WriteOptions::default()
-                });
                 let rel = PathBuf::from("composites").join(format!("{name}.exr"));
                 ibl_io::write_image(&job.out_dir.join(&rel), &out.composite, options)?;
                 ibl_io::write_image(
@@ -258,10 +325,19 @@ pub fn run_outdoor(job: &OutdoorJob, progress: &dyn Progress) -> Result<OutdoorS
                     &out.composite,
                     options,
                 )?;
-                Some(rel)
+                (Some(rel), out.composite)
             }
-            None => None,
+            None => (None, frame),
         };
+        if let Some(video) = &job.video {
+            let size = (shown.width(), shown.height());
+            if writer.is_none() {
+                writer = Some(VideoWriter::create(video, size, job.video_fps)?);
+            }
+            if let Some(w) = writer.as_mut() {
+                w.push(&to_srgb8(&shown, &options.display))?;
+            }
+        }
         let composite_seconds = t1.elapsed().as_secs_f64();
         let relit_map = if job.relit_maps {
             let rel = PathBuf::from("relit").join(format!("{name}.exr"));
@@ -277,7 +353,8 @@ pub fn run_outdoor(job: &OutdoorJob, progress: &dyn Progress) -> Result<OutdoorS
         let hour = start_hour + after / 3600.0;
         frames.push(OutdoorFrame {
             index,
-            file: path.clone(),
+            name,
+            file: path,
             local_time,
             hour,
             sun_elevation_deg: f64::from(result.sun_direction[1].clamp(-1.0, 1.0))
@@ -289,12 +366,23 @@ pub fn run_outdoor(job: &OutdoorJob, progress: &dyn Progress) -> Result<OutdoorS
             estimate_seconds,
             composite_seconds,
         });
-        progress.update(index as u64 + 1, frame_files.len() as u64, None);
+        progress.update(index as u64 + 1, total, None);
     }
     progress.end();
+    if frames.is_empty() {
+        return Err(PipelineError::parameter(format!(
+            "{}: no frame in daylight (every frame's time puts the sun below the horizon, or the video has no frame)",
+            source_path.display()
+        )));
+    }
+    let video = match writer {
+        Some(w) => Some(w.finish()?),
+        None => None,
+    };
     let summary = OutdoorSummary {
         scene: job.scene.clone(),
         skipped,
+        video,
         sample_sites: system.sites().pixels().len(),
         frames,
         setup_seconds,
@@ -341,18 +429,20 @@ fn check_outputs(
     for output in &outputs {
         ibl_io::ensure_output_is_not_input(output, &inputs)?;
     }
+    if let Some(video) = &job.video {
+        // Inside the output folder, which the run creates, or in a folder that exists.
+        let in_out_dir = video.parent() == Some(job.out_dir.as_path()) && !job.out_dir.exists();
+        if in_out_dir {
+            ibl_io::ensure_output_is_not_input(video, &inputs)?;
+        } else {
+            check_output_path(video, &inputs)?;
+        }
+    }
     Ok(())
 }
 
 /// The frame files of `dir` (images with a [`FRAME_EXTENSIONS`] extension, by file name).
 fn list_frames(dir: &Path, max_frames: Option<usize>) -> Result<Vec<PathBuf>> {
-    if dir.is_file() {
-        return Err(PipelineError::parameter(format!(
-            "{}: outdoor.frames.source is a file; decoding video is not built yet: extract its frames first (`ffmpeg -i VIDEO {}/%05d.png`) and name that folder",
-            dir.display(),
-            dir.with_extension("").display()
-        )));
-    }
     let mut files = ibl_io::list_dir(dir)?;
     files.retain(|p| {
         p.extension()
