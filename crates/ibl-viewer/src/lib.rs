@@ -23,7 +23,8 @@
 //! - [`shadow_atlas`]: one shadow map per light, cached by what moves.
 //! - [`scene_pass`]: shading and the differential composite; [`probe_pass`]: the probe viewer;
 //!   [`display_pass`]: exposure and tone curves; [`markers_pass`]: light markers;
-//!   [`lines_pass`]: antialiased lines (the room overlays).
+//!   [`lines_pass`]: antialiased lines (the room overlays); [`overlay_pipeline`]: the
+//!   pipeline both overlay passes share.
 //! - [`scene_renderer`], [`probe_renderer`]: one frame each; [`timing`]: GPU pass timestamps.
 //! - [`headless`]: offscreen frames and the benchmark; [`window`]: the eframe application,
 //!   [`view_state`] what it has open, [`panels`] its widgets ([`room_panel`] the room tools'),
@@ -49,6 +50,7 @@ pub mod light_space;
 pub mod lighting;
 pub mod lines_pass;
 pub mod markers_pass;
+pub mod overlay_pipeline;
 pub mod panels;
 pub mod probe_model;
 pub mod probe_pass;

@@ -7,10 +7,10 @@
 //! curve made of many short segments has an even edge.
 
 use bytemuck::{Pod, Zeroable};
-use wgpu::util::DeviceExt;
 
 use crate::frame_targets::FrameTargets;
-use crate::gpu::{DISPLAY_FORMAT, GpuContext};
+use crate::gpu::GpuContext;
+use crate::overlay_pipeline::OverlayPipeline;
 
 /// One segment, in output pixels (continuous coordinates: pixel `(i, j)` covers `[i, i + 1) x
 /// [j, j + 1)`, row 0 at the top). A segment of length 0 is a disc of radius `half_width`.
@@ -57,66 +57,22 @@ struct GpuSegment {
 /// The pipeline.
 #[derive(Debug)]
 pub struct LinesPass {
-    pipeline: wgpu::RenderPipeline,
-    layout: wgpu::BindGroupLayout,
+    overlay: OverlayPipeline,
 }
 
 impl LinesPass {
     /// Builds the pipeline.
     pub fn new(gpu: &GpuContext) -> LinesPass {
-        let device = &gpu.device;
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("lines_pass.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(include_str!("lines_pass.wgsl").into()),
-        });
-        let buffer = |binding, ty| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::Buffer {
-                ty,
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        };
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("lines"),
-            entries: &[
-                buffer(0, wgpu::BufferBindingType::Uniform),
-                buffer(1, wgpu::BufferBindingType::Storage { read_only: true }),
-            ],
-        });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("lines"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("lines"),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_line"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: wgpu::PrimitiveState::default(),
-            depth_stencil: None,
-            multisample: wgpu::MultisampleState::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_line"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: DISPLAY_FORMAT,
-                    blend: Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING),
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
-        LinesPass { pipeline, layout }
+        LinesPass {
+            overlay: OverlayPipeline::new(
+                gpu,
+                "lines",
+                "lines_pass.wgsl",
+                include_str!("lines_pass.wgsl"),
+                "vs_line",
+                "fs_line",
+            ),
+        }
     }
 
     /// Draws `segments` over `targets.display`, in order (later ones on top).
@@ -144,57 +100,13 @@ impl LinesPass {
             })
             .collect();
         let (w, h) = targets.size;
-        let screen = [w as f32, h as f32, 0.0, 0.0];
-        let init = |label, contents: &[u8], usage| {
-            gpu.device
-                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some(label),
-                    contents,
-                    usage,
-                })
-        };
-        let screen = init(
-            "screen",
-            bytemuck::cast_slice(&screen),
-            wgpu::BufferUsages::UNIFORM,
+        self.overlay.record(
+            gpu,
+            encoder,
+            targets,
+            [w as f32, h as f32, 0.0, 0.0],
+            &data,
+            timestamps,
         );
-        let segments_buffer = init(
-            "segments",
-            bytemuck::cast_slice(&data),
-            wgpu::BufferUsages::STORAGE,
-        );
-        let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("lines"),
-            layout: &self.layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: screen.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: segments_buffer.as_entire_binding(),
-                },
-            ],
-        });
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("lines"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &targets.display_view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Load,
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: None,
-            timestamp_writes: timestamps,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &bind_group, &[]);
-        pass.draw(0..6, 0..data.len() as u32);
     }
 }

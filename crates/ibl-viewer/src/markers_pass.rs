@@ -3,10 +3,10 @@
 //! the frame used ([`crate::view_camera::OutputCamera::project`]) or the lat-long layout.
 
 use bytemuck::{Pod, Zeroable};
-use wgpu::util::DeviceExt;
 
 use crate::frame_targets::FrameTargets;
-use crate::gpu::{DISPLAY_FORMAT, GpuContext};
+use crate::gpu::GpuContext;
+use crate::overlay_pipeline::OverlayPipeline;
 
 /// The look of a marker.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -40,66 +40,22 @@ struct GpuMarker {
 /// The pipeline.
 #[derive(Debug)]
 pub struct MarkersPass {
-    pipeline: wgpu::RenderPipeline,
-    layout: wgpu::BindGroupLayout,
+    overlay: OverlayPipeline,
 }
 
 impl MarkersPass {
     /// Builds the pipeline.
     pub fn new(gpu: &GpuContext) -> MarkersPass {
-        let device = &gpu.device;
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("markers_pass.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(include_str!("markers_pass.wgsl").into()),
-        });
-        let buffer = |binding, ty| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::Buffer {
-                ty,
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        };
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("markers"),
-            entries: &[
-                buffer(0, wgpu::BufferBindingType::Uniform),
-                buffer(1, wgpu::BufferBindingType::Storage { read_only: true }),
-            ],
-        });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("markers"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("markers"),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_marker"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: wgpu::PrimitiveState::default(),
-            depth_stencil: None,
-            multisample: wgpu::MultisampleState::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_marker"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: DISPLAY_FORMAT,
-                    blend: Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING),
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
-        MarkersPass { pipeline, layout }
+        MarkersPass {
+            overlay: OverlayPipeline::new(
+                gpu,
+                "markers",
+                "markers_pass.wgsl",
+                include_str!("markers_pass.wgsl"),
+                "vs_marker",
+                "fs_marker",
+            ),
+        }
     }
 
     /// Draws `markers` over `targets.display` with lines `line_width` pixels wide.
@@ -134,57 +90,13 @@ impl MarkersPass {
             })
             .collect();
         let (w, h) = targets.size;
-        let screen = [w as f32, h as f32, 0.5 * line_width.max(1.0), 0.0];
-        let init = |label, contents: &[u8], usage| {
-            gpu.device
-                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some(label),
-                    contents,
-                    usage,
-                })
-        };
-        let screen = init(
-            "screen",
-            bytemuck::cast_slice(&screen),
-            wgpu::BufferUsages::UNIFORM,
+        self.overlay.record(
+            gpu,
+            encoder,
+            targets,
+            [w as f32, h as f32, 0.5 * line_width.max(1.0), 0.0],
+            &data,
+            timestamps,
         );
-        let markers_buffer = init(
-            "markers",
-            bytemuck::cast_slice(&data),
-            wgpu::BufferUsages::STORAGE,
-        );
-        let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("markers"),
-            layout: &self.layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: screen.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: markers_buffer.as_entire_binding(),
-                },
-            ],
-        });
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("markers"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &targets.display_view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Load,
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: None,
-            timestamp_writes: timestamps,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &bind_group, &[]);
-        pass.draw(0..6, 0..data.len() as u32);
     }
 }
