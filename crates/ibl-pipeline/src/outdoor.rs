@@ -162,12 +162,10 @@ pub fn run_outdoor(job: &OutdoorJob, progress: &dyn Progress) -> Result<OutdoorS
     let location = location(&outdoor);
     let probe_time = timestamp(&outdoor.probe_local_time()?, outdoor.utc_offset_hours)
         .context(format!("{scene_shown}: outdoor.probe_time"))?;
-    let start = timestamp(
-        &outdoor.frames.start_local_time()?,
-        outdoor.utc_offset_hours,
-    )
-    .context(format!("{scene_shown}: outdoor.frames.start"))?;
-    let start_hour = civil_hour(&outdoor.frames.start_local_time()?);
+    let start_civil = outdoor.frames.start_local_time()?;
+    let start = timestamp(&start_civil, outdoor.utc_offset_hours)
+        .context(format!("{scene_shown}: outdoor.frames.start"))?;
+    let start_hour = civil_hour(&start_civil);
     let mask = read_mask(&mask_path)?;
     if let Some(r) = &reader {
         let (w, h) = r.size();
@@ -187,7 +185,6 @@ pub fn run_outdoor(job: &OutdoorJob, progress: &dyn Progress) -> Result<OutdoorS
     // Each frame's time and whether the sun is up then: the model is for daylight, so a night
     // frame is skipped with a note, and a sequence with no daylight frame is refused before the
     // offline step.
-    let start_civil = outdoor.frames.start_local_time()?;
     let daylight = |index: usize| -> Result<bool> {
         let time = start.plus_seconds(outdoor.frames.seconds_after_start(index));
         Ok(location.sun_direction(time, settings.delta_t)?.y > 0.0)
