@@ -10,6 +10,9 @@
 //! - The per-format modules ([`hdr`], [`exr`], [`pfm`], [`ldr`]) are pure byte-level codecs
 //!   (`decode(bytes, limits) -> RawImage`, `encode(image) -> bytes`), for fuzzing and benches.
 //!
+//! - [`photometry`] reads luminaires' intensity distributions (IES LM-63 and EULUMDAT files)
+//!   into the candela tables of `ibl_light::goniometric`, each symmetry expanded.
+//!
 //! Errors name the file and say whether the input was at fault ([`IoError::is_bad_input`]).
 //! The library never prints and never panics on file content.
 //!
@@ -30,6 +33,7 @@ pub mod light_file;
 pub mod mesh_file;
 pub mod pfm;
 pub mod photo;
+pub mod photometry;
 pub mod sanitize;
 pub mod scene_file;
 pub mod scene_write;
@@ -47,6 +51,9 @@ pub use format::{ImageFormat, Limits, RawImage};
 use ibl_core::tonemap::{Display, to_srgb8};
 pub use light_export::{ExportError, ExportOptions, LightFormat, write_light_file};
 pub use mesh_file::{LoadedMesh, MeshLimits, read_mesh};
+pub use photometry::{
+    PhotometricFile, PhotometryLimits, StatedFlux, read_photometry, read_photometry_with_limits,
+};
 pub use sanitize::{SanitizeReport, sanitize};
 pub use scene_file::{LoadedScene, read_scene};
 pub use sh_file::{ShFile, ShFileFormat, ShQuantity, read_sh_file, write_sh_file};

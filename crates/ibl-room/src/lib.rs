@@ -17,6 +17,11 @@
 //!   [`analysis`]: all of 3.2 in one call; [`report`]: Table 1 as JSON and Markdown;
 //!   [`picture`]: patches coloured by reflectance, the model over the panorama.
 //! - [`important`]: the important light patches (3.3).
+//! - Augmenting the room (section 4): [`room_radiance`] (the probe's texture where it saw, the
+//!   estimate `rho E / pi` where it did not), [`irradiance_volume`] (all and unimportant light
+//!   on a grid, 4.1; [`ambient_cube`] the representation it was measured against) and
+//!   [`mod@volume_error`] (its interpolation error against direct gathering), [`material_change`]
+//!   (new reflectances and colour bleeding by delta radiosity, 4.3).
 //! - Geometry from the probe (3.1): [`view`] (perspective views of the panorama), [`marks`] (the
 //!   marks file), [`vanishing`] (vanishing points, axes, `world_from_probe`), [`scale`],
 //!   [`placement`] (shapes by constraints, the room file they make); beyond the paper,
@@ -24,6 +29,7 @@
 //!
 //! This crate does no file I/O: it parses and writes text; `ibl-io` and the front ends own files.
 
+pub mod ambient_cube;
 pub mod analysis;
 pub mod depth_map;
 pub mod description;
@@ -31,9 +37,11 @@ mod error;
 pub mod form_factors;
 pub mod geometry;
 pub mod important;
+pub mod irradiance_volume;
 pub mod line_detection;
 pub mod manhattan;
 pub mod marks;
+pub mod material_change;
 pub mod observation;
 pub mod patches;
 pub mod picture;
@@ -42,9 +50,11 @@ pub mod radiosity;
 pub mod reflectance;
 pub mod report;
 pub mod room;
+pub mod room_radiance;
 pub mod scale;
 pub mod vanishing;
 pub mod view;
+pub mod volume_error;
 
 pub use analysis::{AnalysisSettings, RoomAnalysis, Stage, analyse_room};
 pub use depth_map::ProbeDepthMap;
@@ -52,13 +62,17 @@ pub use description::{GroupKind, RoomDescription, RoomFile};
 pub use error::RoomError;
 pub use form_factors::{FormFactorSettings, FormFactors};
 pub use important::{AreaPatchLight, ImportantLights, important_patches};
+pub use irradiance_volume::{KeyPointVisibility, RoomVolume, VolumeSettings};
 pub use manhattan::{ManhattanProposal, ManhattanSettings, propose_manhattan_frame};
 pub use marks::{Axis, MarksFile};
+pub use material_change::{MaterialChange, MaterialEdit, change_materials};
 pub use observation::{ObservationSettings, Observations, observe};
 pub use placement::reconstruct;
 pub use reflectance::{Estimate, EstimationSettings, estimate_reflectance};
 pub use report::RoomReport;
 pub use room::{Group, Room};
+pub use room_radiance::RoomRadiance;
 pub use scale::{Scale, probe_height};
 pub use vanishing::{Calibration, calibrate, line_observations};
 pub use view::PerspectiveView;
+pub use volume_error::{VolumeError, VolumeErrorSettings, volume_error};

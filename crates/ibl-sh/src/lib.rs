@@ -2,7 +2,7 @@
 //! order, projection of lat-long probes with exact solid angles, rotation of every band, Lambert
 //! convolution to irradiance (Ramamoorthi & Hanrahan 2001) with optional windowing, and the
 //! radiance and irradiance coefficient sets as distinct types, and irradiance volumes (grids of
-//! L2 irradiance key points, shared by the indoor and outdoor pipelines).
+//! irradiance key points, L2 by default, shared by the indoor and outdoor pipelines).
 
 pub mod basis;
 pub mod coefficients;
@@ -18,7 +18,8 @@ pub use convolution::{Window, lambert_factor};
 pub use projection::project_latlong;
 pub use rotation::ShRotation;
 pub use volume::{
-    IrradianceL2, IrradianceVolume, LeakControl, VolumeGrid, VolumeLayer, VolumeLayers,
+    IrradianceL2, IrradianceVolume, KeyPointIrradiance, KeyPointVolume, LeakControl, VolumeGrid,
+    VolumeLayer, VolumeLayers,
 };
 
 /// Why an SH operation could not run.

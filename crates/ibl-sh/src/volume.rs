@@ -7,6 +7,11 @@
 //! relit environment map; Grosch 2005 keeps two layers per key point, all light and the light of
 //! the "unimportant" patches, so a volume holds one or two [`VolumeLayer`]s.
 //!
+//! **Key points.** [`KeyPointVolume`] is generic over what a key point holds (any
+//! [`KeyPointIrradiance`]: a linear, normal-dependent irradiance that can be weighted and summed);
+//! [`IrradianceVolume`] is the L2 volume both pipelines use, and other representations (the
+//! room's ambient cube, `ibl-room`) share the grid, the validity and the interpolation.
+//!
 //! **Grid**: key point `(ix, iy, iz)` sits at `origin + (ix, iy, iz) * spacing` (metres, world
 //! frame), index `ix + nx (iy + ny iz)`. A point can be **invalid** (inside a wall, below the
 //! ground): it is never interpolated from.
@@ -17,8 +22,11 @@
 //! corner's weight is also multiplied by `max(0.05, (1 + n . u) / 2)^2`, `u` the unit vector from
 //! `p` to the corner and `n` the surface normal, so key points behind the surface (often on the
 //! far side of a thin wall, where the light is different) count little (the "backface" weight
-//! of Majercik et al. 2019, DDGI). The weights are renormalised; if all vanish the look-up fails.
-//! Cost O(1) per look-up (eight corners, 27 coefficients each).
+//! of Majercik et al. 2019, DDGI). [`KeyPointVolume::sample_visible`] also gives weight 0 to
+//! every corner a caller's visibility test rejects (a wall or a box face between the position and
+//! the key point, which only the caller's geometry can tell). The weights are renormalised; if
+//! all vanish the look-up fails. Cost O(1) per look-up (eight corners, 27 coefficients each for
+//! L2), plus the caller's visibility tests.
 
 use ibl_core::glam::{DVec3, Vec3};
 
@@ -163,6 +171,29 @@ impl IrradianceL2 {
     }
 }
 
+/// What a key point of a [`KeyPointVolume`] holds: an irradiance that depends on the surface
+/// normal and is linear in the light, so interpolation is a weighted sum of key points.
+pub trait KeyPointIrradiance: Copy + std::fmt::Debug + PartialEq + Send + Sync {
+    /// No light.
+    const ZERO: Self;
+    /// `self += weight * other`.
+    fn add_scaled(&mut self, other: &Self, weight: f32);
+    /// The irradiance on a surface with unit normal `n` (world frame), per channel.
+    fn irradiance(&self, n: Vec3) -> [f32; 3];
+}
+
+impl KeyPointIrradiance for IrradianceL2 {
+    const ZERO: IrradianceL2 = IrradianceL2::ZERO;
+
+    fn add_scaled(&mut self, other: &IrradianceL2, weight: f32) {
+        IrradianceL2::add_scaled(self, other, weight);
+    }
+
+    fn irradiance(&self, n: Vec3) -> [f32; 3] {
+        IrradianceL2::irradiance(self, n)
+    }
+}
+
 /// Which light a layer holds (Grosch 2005 keeps both per key point).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum VolumeLayer {
@@ -201,25 +232,28 @@ pub enum LeakControl {
     Facing(Vec3),
 }
 
-/// A grid of key points with validity and one or two layers of L2 irradiance.
+/// A grid of key points with validity and one or two layers of irradiance `P` per point.
 #[derive(Clone, Debug, PartialEq)]
-pub struct IrradianceVolume {
+pub struct KeyPointVolume<P> {
     grid: VolumeGrid,
     layers: VolumeLayers,
     valid: Vec<bool>,
     /// `layer * len + index`.
-    data: Vec<IrradianceL2>,
+    data: Vec<P>,
 }
 
-impl IrradianceVolume {
+/// The volume of L2 irradiance key points (both pipelines' volume).
+pub type IrradianceVolume = KeyPointVolume<IrradianceL2>;
+
+impl<P: KeyPointIrradiance> KeyPointVolume<P> {
     /// A volume of zero irradiance, every point valid.
-    pub fn new(grid: VolumeGrid, layers: VolumeLayers) -> IrradianceVolume {
+    pub fn new(grid: VolumeGrid, layers: VolumeLayers) -> KeyPointVolume<P> {
         let n = grid.len();
-        IrradianceVolume {
+        KeyPointVolume {
             grid,
             layers,
             valid: vec![true; n],
-            data: vec![IrradianceL2::ZERO; n * layers.count()],
+            data: vec![P::ZERO; n * layers.count()],
         }
     }
 
@@ -254,26 +288,39 @@ impl IrradianceVolume {
     }
 
     /// One layer's key points, in index order.
-    pub fn layer(&self, layer: VolumeLayer) -> Result<&[IrradianceL2], ShError> {
+    pub fn layer(&self, layer: VolumeLayer) -> Result<&[P], ShError> {
         let start = self.offset(layer)?;
         Ok(&self.data[start..start + self.grid.len()])
     }
 
     /// One layer's key points, to write.
-    pub fn layer_mut(&mut self, layer: VolumeLayer) -> Result<&mut [IrradianceL2], ShError> {
+    pub fn layer_mut(&mut self, layer: VolumeLayer) -> Result<&mut [P], ShError> {
         let start = self.offset(layer)?;
         let n = self.grid.len();
         Ok(&mut self.data[start..start + n])
     }
 
-    /// The interpolated L2 irradiance at `position` (see the module doc); `None` when every
+    /// The interpolated irradiance at `position` (see the module doc); `None` when every
     /// corner has weight 0.
     pub fn sample(
         &self,
         position: Vec3,
         layer: VolumeLayer,
         leak: LeakControl,
-    ) -> Result<Option<IrradianceL2>, ShError> {
+    ) -> Result<Option<P>, ShError> {
+        self.sample_visible(position, layer, leak, |_| true)
+    }
+
+    /// [`Self::sample`] where a corner key point also gets weight 0 when `visible(key_point)`
+    /// (its world position, metres) is false: a wall between `position` and the key point.
+    /// `visible` is asked only about corners that still have weight after `leak`, at most eight.
+    pub fn sample_visible(
+        &self,
+        position: Vec3,
+        layer: VolumeLayer,
+        leak: LeakControl,
+        visible: impl Fn(Vec3) -> bool,
+    ) -> Result<Option<P>, ShError> {
         let data = self.layer(layer)?;
         let g = &self.grid;
         let t = (position.as_dvec3() - g.origin) / g.spacing;
@@ -286,7 +333,8 @@ impl IrradianceVolume {
             base[a] = i0;
             frac[a] = if n > 1 { ta - i0 as f64 } else { 0.0 };
         }
-        let mut out = IrradianceL2::ZERO;
+        let mut corners = [(0usize, 0.0f64); 8];
+        let mut used = 0;
         let mut total = 0.0f64;
         for corner in 0..8 {
             let mut idx = [0usize; 3];
@@ -312,15 +360,19 @@ impl IrradianceVolume {
                     }
                 }
             }
-            out.add_scaled(&data[index], w as f32);
+            if !visible(g.position(index).as_vec3()) {
+                continue;
+            }
+            corners[used] = (index, w);
+            used += 1;
             total += w;
         }
         if total.is_nan() || total <= 0.0 {
             return Ok(None);
         }
-        let inv = (1.0 / total) as f32;
-        for c in &mut out.coefficients {
-            *c = c.map(|v| v * inv);
+        let mut out = P::ZERO;
+        for &(index, w) in &corners[..used] {
+            out.add_scaled(&data[index], (w / total) as f32);
         }
         Ok(Some(out))
     }
@@ -445,5 +497,30 @@ mod tests {
         );
         let single = IrradianceVolume::new(g, VolumeLayers::AllLight);
         assert!(single.layer(VolumeLayer::UnimportantLight).is_err());
+    }
+
+    #[test]
+    fn corners_behind_a_wall_do_not_leak() {
+        let v = volume();
+        // A wall at x = 0.25 seen from x = 0.5: the x = 0 corners are hidden, so the look-up
+        // reads the x = 1 plane only (the linear field at x = 1, y = 0, z = 0: 12).
+        let p = Vec3::new(0.5, 0.0, 0.0);
+        let s = v
+            .sample_visible(p, VolumeLayer::AllLight, LeakControl::ValidOnly, |k| {
+                k.x > 0.25
+            })
+            .unwrap()
+            .unwrap();
+        assert!((s.irradiance(Vec3::Y)[0] - 12.0).abs() < 1e-5);
+        // Everything hidden: no answer; nothing hidden: the plain look-up.
+        assert!(
+            v.sample_visible(p, VolumeLayer::AllLight, LeakControl::ValidOnly, |_| false)
+                .unwrap()
+                .is_none()
+        );
+        assert_eq!(
+            v.sample_visible(p, VolumeLayer::AllLight, LeakControl::None, |_| true),
+            v.sample(p, VolumeLayer::AllLight, LeakControl::None)
+        );
     }
 }
