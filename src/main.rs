@@ -31,6 +31,7 @@ Examples:
   ibl preview probe.exr probe.png --tonemap aces
   ibl lights probe.exr -n 16 -o lights.json
   ibl eval assets/probes/*.exr --out eval     compare every extraction method (report.md)
+  ibl batch assets/batch/bundled.toml        lights, SH, previews for a folder of probes
   ibl prefilter probe.exr -o env.ktx2        GGX mip chain, irradiance, SH, DFG for engines
   ibl render assets/scenes/bunny-sky.toml -o bunny.exr   the bunny composited into a probe
   ibl compare render.exr reference.exr       RMSE, relative MSE and FLIP of a render
@@ -56,6 +57,8 @@ enum Command {
     Prefilter(cmd::prefilter::PrefilterArgs),
     /// Compare the light extraction methods on probes: error vs N, plots, spheres, report.
     Eval(cmd::eval::EvalArgs),
+    /// Run per-probe steps (info, lights, SH, maps, previews, eval) over many probes.
+    Batch(cmd::batch::BatchArgs),
     /// Error metrics of an image against a reference: RMSE, relative MSE, FLIP; error images.
     Compare(cmd::compare::CompareArgs),
     /// Make a probe with a camera: merge brackets, unwrap mirror balls, stitch fisheyes.
@@ -95,6 +98,7 @@ fn main() -> ExitCode {
         Command::Sh(args) => cmd::sh::run(&args),
         Command::Prefilter(args) => cmd::prefilter::run(&args),
         Command::Eval(args) => cmd::eval::run(&args),
+        Command::Batch(args) => cmd::batch::run(&args),
         Command::Compare(args) => cmd::compare::run(&args),
         Command::Render(args) => cmd::render::run(&args),
         Command::Capture(args) => cmd::capture::run(&args),

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use clap::{ArgGroup, Args, ValueEnum};
 use ibl_core::FramePreset;
 use ibl_extract::ExtractOptions;
-use ibl_light::{LightSet, Method};
+use ibl_light::Method;
 use ibl_pipeline::lights::{LightsOptions, lights};
 
 use crate::probe_arg::ProbeMappingArgs;
@@ -141,41 +141,9 @@ pub fn run(args: &LightsArgs) -> anyhow::Result<()> {
         });
         println!("{summary:#}");
     } else {
-        print_summary(set, &result.probe_power);
+        print!("{}", result.summary_text());
     }
     Ok(())
-}
-
-fn print_summary(set: &LightSet, probe_power: &[f64; 3]) {
-    let p = set.total_power();
-    println!(
-        "{} lights by {}; power {:.5e} {:.5e} {:.5e} (probe {:.5e} {:.5e} {:.5e})",
-        set.lights.len(),
-        set.provenance.extraction.name(),
-        p[0],
-        p[1],
-        p[2],
-        probe_power[0],
-        probe_power[1],
-        probe_power[2]
-    );
-    let mut order: Vec<usize> = (0..set.lights.len()).collect();
-    let lum = |i: &usize| set.lights[*i].irradiance.luminance();
-    order.sort_by(|a, b| lum(b).total_cmp(&lum(a)));
-    println!("strongest lights (world direction, solid angle sr, irradiance I = L A):");
-    for i in order.iter().take(5) {
-        let l = &set.lights[*i];
-        println!(
-            "  ({:+.4}, {:+.4}, {:+.4})  {:.3e}  {:.4e} {:.4e} {:.4e}",
-            l.direction[0],
-            l.direction[1],
-            l.direction[2],
-            l.solid_angle_sr,
-            l.irradiance[0],
-            l.irradiance[1],
-            l.irradiance[2]
-        );
-    }
 }
 
 #[cfg(test)]

@@ -1,5 +1,6 @@
 //! One module per subcommand.
 
+pub mod batch;
 pub mod capture;
 pub mod compare;
 pub mod convert;

@@ -25,6 +25,23 @@ pub enum ToneCurve {
 }
 
 impl ToneCurve {
+    /// Every curve, in the order the command line lists them.
+    pub const ALL: [ToneCurve; 3] = [ToneCurve::Clamp, ToneCurve::Reinhard, ToneCurve::AcesFilmic];
+
+    /// `clamp`, `reinhard` or `aces`, as the command line, the viewer and batch specs name it.
+    pub fn name(self) -> &'static str {
+        match self {
+            ToneCurve::Clamp => "clamp",
+            ToneCurve::Reinhard => "reinhard",
+            ToneCurve::AcesFilmic => "aces",
+        }
+    }
+
+    /// The curve [`ToneCurve::name`] names.
+    pub fn from_name(name: &str) -> Option<ToneCurve> {
+        ToneCurve::ALL.into_iter().find(|c| c.name() == name)
+    }
+
     /// Applies the curve to one exposed linear value (`x >= 0`), giving a value in `[0, 1]`.
     pub fn apply(self, x: f32) -> f32 {
         match self {

@@ -172,6 +172,14 @@ impl LightsFile {
     }
 }
 
+/// SHA-256 of bytes, lower-case hex.
+pub fn sha256_hex(bytes: &[u8]) -> String {
+    Sha256::digest(bytes)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect()
+}
+
 /// SHA-256 of a file, lower-case hex. Streams the file (O(1) memory).
 pub fn sha256_file(path: &Path) -> Result<String, IoError> {
     let io = |source| IoError::Io {

@@ -249,6 +249,29 @@ fn compute(
     })
 }
 
+/// The irradiance map of a lat-long probe in memory (the Python bindings' `irradiance_map`): the
+/// job's evaluators and texel directions, without files.
+pub fn irradiance_map_of(
+    probe: &Image<Rgb>,
+    method: IrradianceMethod,
+    bands: usize,
+    window: Window,
+    to: Mapping,
+    width: usize,
+) -> Result<Image<Rgb>> {
+    if width == 0 || width > MAX_WIDTH {
+        return Err(PipelineError::parameter(format!(
+            "the map width must be between 1 and {MAX_WIDTH}"
+        )));
+    }
+    let evaluator = match method {
+        IrradianceMethod::Exact => Evaluator::Exact(probe),
+        IrradianceMethod::Fast => Evaluator::Fast(probe),
+        IrradianceMethod::Sh => Evaluator::Sh(project_latlong(probe, bands)?.irradiance(window)),
+    };
+    Ok(irradiance_map(&evaluator, to, width))
+}
+
 /// The irradiance map: `E(n)` at every texel centre's direction of `mapping` at `width`
 /// (texels outside a disc mapping's disc, or in an unused cross cell, are black). O(texels) calls
 /// of the evaluator, which runs them in parallel.

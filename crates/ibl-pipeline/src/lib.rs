@@ -23,6 +23,8 @@
 //!   and out through ffmpeg;
 //! - [`capture`]: brackets merged to HDR ([`exposure_list`]: the time files it reads);
 //!   [`capture_views`]: mirror balls and fisheye pairs;
+//! - [`batch`]: the per-probe pipeline over a folder, a glob or a list, one row per probe, as
+//!   [`batch_spec`] says (`ibl batch`, `python -m iblkit.batch`);
 //! - [`demo`]: the main job on the bundled probes and scenes ([`demo_probe`], [`demo_render`],
 //!   [`demo_page`], [`demo_paths`], [`demo_room`], [`demo_outdoor`]; [`demo_text`]: what the
 //!   command line prints after the demo and the comparison).
@@ -32,6 +34,8 @@
 //! Errors are [`PipelineError`]s, split by cause; [`PipelineError::is_bad_input`] tells the
 //! caller's fault from ours.
 
+pub mod batch;
+pub mod batch_spec;
 pub mod capture;
 pub mod capture_views;
 pub mod compare;

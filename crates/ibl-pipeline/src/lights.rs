@@ -63,6 +63,37 @@ pub struct LightsResult {
     pub probe: ProbeDetection,
 }
 
+impl LightsResult {
+    /// What `ibl lights` prints: the count and power, then the five strongest lights.
+    pub fn summary_text(&self) -> String {
+        let set = &self.set;
+        let (p, q) = (set.total_power(), self.probe_power);
+        let mut text = format!(
+            "{} lights by {}; power {:.5e} {:.5e} {:.5e} (probe {:.5e} {:.5e} {:.5e})\n",
+            set.lights.len(),
+            set.provenance.extraction.name(),
+            p[0],
+            p[1],
+            p[2],
+            q[0],
+            q[1],
+            q[2]
+        );
+        let mut order: Vec<usize> = (0..set.lights.len()).collect();
+        let lum = |i: &usize| set.lights[*i].irradiance.luminance();
+        order.sort_by(|a, b| lum(b).total_cmp(&lum(a)));
+        text.push_str("strongest lights (world direction, solid angle sr, irradiance I = L A):\n");
+        for l in order.iter().take(5).map(|i| &set.lights[*i]) {
+            let (d, e) = (l.direction, l.irradiance);
+            text.push_str(&format!(
+                "  ({:+.4}, {:+.4}, {:+.4})  {:.3e}  {:.4e} {:.4e} {:.4e}\n",
+                d[0], d[1], d[2], l.solid_angle_sr, e[0], e[1], e[2]
+            ));
+        }
+        text
+    }
+}
+
 /// The options' outputs with their formats, checked before any work.
 fn check(o: &LightsOptions) -> Result<Vec<(&Path, LightFormat)>> {
     if o.outputs.is_empty() && o.overlay.is_none() {

@@ -132,8 +132,8 @@ fn project(
     })
 }
 
-/// Radiance coefficients with band `l` times the window's weight.
-fn windowed(sh: &RadianceSh, window: Window) -> Vec<[f64; 3]> {
+/// Radiance coefficients with band `l` times the window's weight (`ibl sh`'s radiance output).
+pub fn windowed(sh: &RadianceSh, window: Window) -> Vec<[f64; 3]> {
     let bands = sh.bands();
     sh.coefficients()
         .iter()
