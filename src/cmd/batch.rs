@@ -33,13 +33,8 @@ pub struct BatchArgs {
 
 /// Runs `ibl batch`.
 pub fn run(args: &BatchArgs) -> anyhow::Result<()> {
-    let spec = BatchSpec::read(&args.spec)?;
-    let summary = run_batch(
-        &spec,
-        args.jobs as usize,
-        args.retry_failed,
-        &Bars::default(),
-    )?;
+    let (spec, bars) = (BatchSpec::read(&args.spec)?, Bars::default());
+    let summary = run_batch(&spec, args.jobs as usize, args.retry_failed, &bars)?;
     match args.json {
         true => println!("{:#}", serde_json::to_value(&summary)?),
         false => print!("{}", summary.text()),
