@@ -21,7 +21,9 @@
 //!   estimate `rho E / pi` where it did not), [`irradiance_volume`] (all and unimportant light
 //!   on a grid, 4.1; [`ambient_cube`] the representation it was measured against) and
 //!   [`mod@volume_error`] (its interpolation error against direct gathering), [`material_change`]
-//!   (new reflectances and colour bleeding by delta radiosity, 4.3).
+//!   (new reflectances and colour bleeding by delta radiosity, 4.3), [`novel_view`] (the room
+//!   from a moved camera, 4.4) with [`fill_texture`] (its fill modulated by the seen texture,
+//!   beyond the paper).
 //! - Geometry from the probe (3.1): [`view`] (perspective views of the panorama), [`marks`] (the
 //!   marks file), [`vanishing`] (vanishing points, axes, `world_from_probe`), [`scale`],
 //!   [`placement`] (shapes by constraints, the room file they make); beyond the paper,
@@ -34,6 +36,7 @@ pub mod analysis;
 pub mod depth_map;
 pub mod description;
 mod error;
+pub mod fill_texture;
 pub mod form_factors;
 pub mod geometry;
 pub mod important;
@@ -42,6 +45,7 @@ pub mod line_detection;
 pub mod manhattan;
 pub mod marks;
 pub mod material_change;
+pub mod novel_view;
 pub mod observation;
 pub mod patches;
 pub mod picture;
@@ -60,12 +64,14 @@ pub use analysis::{AnalysisSettings, RoomAnalysis, Stage, analyse_room};
 pub use depth_map::ProbeDepthMap;
 pub use description::{GroupKind, RoomDescription, RoomFile};
 pub use error::RoomError;
+pub use fill_texture::{FillTexture, FillTextureSettings};
 pub use form_factors::{FormFactorSettings, FormFactors};
 pub use important::{AreaPatchLight, ImportantLights, important_patches};
 pub use irradiance_volume::{KeyPointVisibility, RoomVolume, VolumeSettings};
 pub use manhattan::{ManhattanProposal, ManhattanSettings, propose_manhattan_frame};
 pub use marks::{Axis, MarksFile};
 pub use material_change::{MaterialChange, MaterialEdit, change_materials};
+pub use novel_view::{HoleFill, NovelView, NovelViewSettings, render_novel_view};
 pub use observation::{ObservationSettings, Observations, observe};
 pub use placement::reconstruct;
 pub use reflectance::{Estimate, EstimationSettings, estimate_reflectance};
