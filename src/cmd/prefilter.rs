@@ -108,13 +108,8 @@ fn texel_format(name: &str) -> Result<TexelFormat, String> {
 }
 
 fn dfg_layout(name: &str) -> Result<DfgLayout, String> {
-    match name {
-        "scale-bias" => Ok(DfgLayout::ScaleBias),
-        "multiscatter" | "multi-scatter" => Ok(DfgLayout::MultiScatter),
-        other => Err(format!(
-            "unknown DFG layout `{other}` (scale-bias, multiscatter)"
-        )),
-    }
+    DfgLayout::from_name(name)
+        .ok_or_else(|| format!("unknown DFG layout `{name}` (scale-bias, multiscatter)"))
 }
 
 /// Runs `ibl prefilter`.

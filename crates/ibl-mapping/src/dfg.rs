@@ -74,6 +74,18 @@ pub fn dfg_scale_bias(n_v: f64, roughness: f64, samples: usize) -> (f64, f64) {
     (a / n as f64, b / n as f64)
 }
 
+impl DfgLayout {
+    /// The layout by the name the command line and the bindings use: `scale-bias`, or
+    /// `multi-scatter` (also spelled `multiscatter`).
+    pub fn from_name(name: &str) -> Option<DfgLayout> {
+        match name {
+            "scale-bias" => Some(DfgLayout::ScaleBias),
+            "multiscatter" | "multi-scatter" => Some(DfgLayout::MultiScatter),
+            _ => None,
+        }
+    }
+}
+
 impl Dfg {
     /// Computes a `size x size` table with `samples` GGX samples per texel (rows in parallel).
     pub fn new(size: usize, samples: usize, layout: DfgLayout) -> Dfg {

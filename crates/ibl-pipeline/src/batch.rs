@@ -282,7 +282,7 @@ impl Progress for Notes {
 /// Runs every step of the spec on one item and writes its files and, last, its `row.json`;
 /// returns the row. A step's failure is the row's (status `failed`), not an error: only failing
 /// to write the row itself is.
-pub fn run_item(spec: &BatchSpec, plan: &BatchPlan, item: &BatchItem) -> Result<Value> {
+pub fn run_item(spec: &BatchSpec, item: &BatchItem) -> Result<Value> {
     let start = Instant::now();
     let folder = spec.out.join(&item.id);
     let notes = Notes::default();
@@ -290,7 +290,7 @@ pub fn run_item(spec: &BatchSpec, plan: &BatchPlan, item: &BatchItem) -> Result<
         "format": ROW_FORMAT,
         "id": item.id,
         "probe": item.probe.display().to_string(),
-        "steps_sha256": plan.steps_sha256,
+        "steps_sha256": spec.steps_sha256(),
     });
     let steps = ibl_io::create_dir_all(&folder)
         .map_err(PipelineError::from)
@@ -564,7 +564,7 @@ pub fn run_batch(
         loop {
             let i = next.fetch_add(1, Ordering::Relaxed);
             let Some(item) = pending.get(i) else { break };
-            match run_item(spec, &plan, item) {
+            match run_item(spec, item) {
                 Ok(row) => {
                     if row["status"] != "ok" {
                         progress.note(&format!(
@@ -596,13 +596,4 @@ pub fn run_batch(
         return Err(e);
     }
     finish(spec, &plan, pending.len(), skipped, start)
-}
-
-/// The item called `id`, for front ends that schedule items themselves (Python), or a
-/// parameter error naming it.
-pub fn find_item<'a>(plan: &'a BatchPlan, id: &str) -> Result<&'a BatchItem> {
-    plan.items
-        .iter()
-        .find(|i| i.id == id)
-        .ok_or_else(|| PipelineError::parameter(format!("no probe `{id}` in this batch")))
 }

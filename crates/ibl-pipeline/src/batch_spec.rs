@@ -484,17 +484,13 @@ fn typed_steps(s: &Steps) -> std::result::Result<TypedSteps, String> {
     };
     let irradiance = match &s.irradiance {
         Some(i) => {
-            use crate::irradiance::IrradianceMethod as M;
-            let method = match i.method.as_str() {
-                "exact" => M::Exact,
-                "fast" => M::Fast,
-                "sh" => M::Sh,
-                other => {
-                    return Err(format!(
-                        "[steps.irradiance] method: `{other}` (exact, fast, sh)"
-                    ));
-                }
-            };
+            let method =
+                crate::irradiance::IrradianceMethod::from_name(&i.method).ok_or_else(|| {
+                    format!(
+                        "[steps.irradiance] method: `{}` (exact, fast, sh)",
+                        i.method
+                    )
+                })?;
             let mapping = EnvMapping::parse(&i.mapping, 180.0)
                 .map_err(|e| format!("[steps.irradiance] mapping: {e}"))?;
             if mapping == EnvMapping::CubeFaces {

@@ -35,6 +35,17 @@ pub enum IrradianceMethod {
 }
 
 impl IrradianceMethod {
+    /// The method [`IrradianceMethod::name`] names.
+    pub fn from_name(name: &str) -> Option<IrradianceMethod> {
+        [
+            IrradianceMethod::Exact,
+            IrradianceMethod::Fast,
+            IrradianceMethod::Sh,
+        ]
+        .into_iter()
+        .find(|m| m.name() == name)
+    }
+
     /// `exact`, `fast` or `sh`.
     pub fn name(self) -> &'static str {
         match self {

@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use ibl_pipeline::batch::{self, BatchPlan};
+use ibl_pipeline::batch::{self, BatchItem, BatchPlan};
 use ibl_pipeline::batch_spec::BatchSpec;
 use pyo3::prelude::*;
 
@@ -32,13 +32,24 @@ fn batch_plan(py: Python<'_>, spec: PathBuf, retry_failed: bool) -> PyResult<Bou
     json_to_py(py, &value)
 }
 
-/// Runs every step on the item `id` and writes its files and `row.json`; returns the row.
+/// Runs every step on one item of a plan (its `id` and `probe`, as `batch_plan` listed them)
+/// and writes its files and `row.json`; returns the row. The spec is read, not planned again:
+/// a worker's call costs one item's work, not a listing of the whole input.
 #[pyfunction]
-fn batch_run_item<'py>(py: Python<'py>, spec: PathBuf, id: &str) -> PyResult<Bound<'py, PyAny>> {
+fn batch_run_item<'py>(
+    py: Python<'py>,
+    spec: PathBuf,
+    id: String,
+    probe: PathBuf,
+) -> PyResult<Bound<'py, PyAny>> {
     let row = py.detach(|| {
-        let (spec, plan) = read(&spec, true)?;
-        let item = batch::find_item(&plan, id).map_err(to_py)?;
-        batch::run_item(&spec, &plan, item).map_err(to_py)
+        let spec = BatchSpec::read(&spec).map_err(to_py)?;
+        let item = BatchItem {
+            id,
+            probe,
+            done: false,
+        };
+        batch::run_item(&spec, &item).map_err(to_py)
     })?;
     json_to_py(py, &row)
 }

@@ -31,12 +31,8 @@ fn irradiance_map<'py>(
     bands: usize,
 ) -> PyResult<Bound<'py, PyArray3<f32>>> {
     let image = image_from(probe, "probe")?;
-    let method = match method {
-        "exact" => IrradianceMethod::Exact,
-        "fast" => IrradianceMethod::Fast,
-        "sh" => IrradianceMethod::Sh,
-        other => return Err(bad(format!("unknown method `{other}` (exact, fast, sh)"))),
-    };
+    let method = IrradianceMethod::from_name(method)
+        .ok_or_else(|| bad(format!("unknown method `{method}` (exact, fast, sh)")))?;
     let to = self::mapping(mapping)?;
     let map = py.detach(|| {
         ibl_pipeline::irradiance::irradiance_map_of(
@@ -146,15 +142,11 @@ fn dfg_table<'py>(
     samples: usize,
     layout: &str,
 ) -> PyResult<Bound<'py, PyArray3<f32>>> {
-    let layout = match layout {
-        "scale-bias" => DfgLayout::ScaleBias,
-        "multi-scatter" => DfgLayout::MultiScatter,
-        other => {
-            return Err(bad(format!(
-                "unknown layout `{other}` (scale-bias, multi-scatter)"
-            )));
-        }
-    };
+    let layout = DfgLayout::from_name(layout).ok_or_else(|| {
+        bad(format!(
+            "unknown DFG layout `{layout}` (scale-bias, multiscatter)"
+        ))
+    })?;
     let options = PrefilterOptions {
         dfg: Some(DfgOptions {
             size,

@@ -32,17 +32,12 @@ fn render_scene<'py>(
     seed: Option<u64>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<(Bound<'py, PyArray3<f32>>, Bound<'py, PyAny>)> {
-    let mode = match mode {
-        None => None,
-        Some("reference") => Some(RenderMode::Reference),
-        Some("lights") => Some(RenderMode::Lights),
-        Some("hybrid") => Some(RenderMode::Hybrid),
-        Some(other) => {
-            return Err(bad(format!(
-                "unknown mode `{other}` (reference, lights, hybrid)"
-            )));
-        }
-    };
+    let mode = mode
+        .map(|m| {
+            RenderMode::from_name(m)
+                .ok_or_else(|| bad(format!("unknown mode `{m}` (reference, lights, hybrid)")))
+        })
+        .transpose()?;
     let job = RenderJob {
         scene,
         output: output.clone(),

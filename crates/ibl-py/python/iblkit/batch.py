@@ -38,9 +38,9 @@ from typing import Any, Callable, Dict, Optional
 from . import _native
 
 
-def _run_item(spec: str, item_id: str) -> Dict[str, Any]:
+def _run_item(spec: str, item: Dict[str, Any]) -> Dict[str, Any]:
     """One probe on a worker: every step, its files and its row (the GIL released)."""
-    return _native.batch_run_item(spec, item_id)
+    return _native.batch_run_item(spec, item["id"], item["probe"])
 
 
 def _set_threads(threads: int) -> None:
@@ -66,7 +66,7 @@ def run(
     spec = os.fspath(spec)
     start = time.monotonic()
     plan = _native.batch_plan(spec, retry_failed)
-    pending = [item["id"] for item in plan["items"] if not item["done"]]
+    pending = [item for item in plan["items"] if not item["done"]]
     if pending:
         _map_on_dask(spec, pending, workers, threads_per_worker, scheduler, progress)
     skipped = len(plan["items"]) - len(pending)

@@ -115,6 +115,17 @@ pub enum RenderMode {
 }
 
 impl RenderMode {
+    /// The mode [`RenderMode::name`] names.
+    pub fn from_name(name: &str) -> Option<RenderMode> {
+        [
+            RenderMode::Reference,
+            RenderMode::Lights,
+            RenderMode::Hybrid,
+        ]
+        .into_iter()
+        .find(|m| m.name() == name)
+    }
+
     /// The name used in files and on the command line.
     pub fn name(self) -> &'static str {
         match self {
