@@ -12,7 +12,8 @@ use crate::progress::Bars;
 The spec (TOML, docs/BATCH.md) names the probes ([input] folder, glob, list or files), the output
 folder and the steps, [steps.info|lights|sh|irradiance|prefilter|preview|eval], set as the
 commands of those names. OUT/<id>/ gets each probe's files and row.json, OUT/results.jsonl one
-row per probe. A rerun skips the probes done; a failed probe is a row, not a stop.
+row per probe. A rerun skips the probes done; a failed probe is a row, not a stop (the
+batch goes on, then exits 2).
 
 Examples:
   ibl batch assets/batch/bundled.toml
@@ -39,5 +40,14 @@ pub fn run(args: &BatchArgs) -> anyhow::Result<()> {
         true => println!("{:#}", serde_json::to_value(&summary)?),
         false => print!("{}", summary.text()),
     }
-    Ok(())
+    match summary.failed.len() {
+        0 => Ok(()),
+        // Exit 2, as `python -m iblkit.batch`: a probe's input was at fault, or iblkit failed
+        // on it; its row says which (`error_kind`).
+        n => Err(ibl_pipeline::PipelineError::parameter(format!(
+            "{n} of {} probes failed; their rows are in {}",
+            summary.items, summary.rows
+        ))
+        .into()),
+    }
 }
