@@ -221,6 +221,31 @@ fn bad_input_is_refused_with_status_2() {
     assert_eq!(std::fs::read(&probe).unwrap(), before);
 }
 
+#[test]
+fn more_shadowed_lights_than_the_viewer_draws_are_refused_with_status_2() {
+    let dir = tempfile::tempdir().unwrap();
+    let frame = dir.path().join("frame.png");
+    let args = [
+        "view",
+        &scene("bunny-sky.toml"),
+        "--headless",
+        "--size",
+        "32x24",
+        "-n",
+        "512",
+        "-o",
+        frame.to_str().unwrap(),
+    ];
+    let out = ibl(&args);
+    if no_adapter(&out, "more_shadowed_lights_than_the_viewer_draws") {
+        return;
+    }
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("at most 256 shadowed lights"), "{err}");
+    assert!(!frame.exists(), "no frame written");
+}
+
 /// Pixels of `image` that are exactly `colour`.
 fn count_exactly(image: &ibl_core::Image<[u8; 3]>, colour: [u8; 3]) -> usize {
     image.pixels().iter().filter(|&&p| p == colour).count()

@@ -36,6 +36,8 @@ pub struct FrameUniform {
     pub environment: [f32; 4],
     /// real atlas size, virtual atlas size (texels).
     pub atlas: [f32; 4],
+    /// The flat real layer's plane `(n, d)`, `n . p + d = 0` (zero when it is not flat).
+    pub real_plane: [f32; 4],
 }
 
 /// `Light` of `gpu_scene.wgsl`.
@@ -149,10 +151,8 @@ pub struct GpuScene {
     pub materials: wgpu::Buffer,
     /// Object transforms (storage), real first.
     pub transforms: wgpu::Buffer,
-    /// Lights (storage), at least one entry.
+    /// Lights (uniform), [`MAX_SHADOWED_LIGHTS`] entries.
     pub lights: wgpu::Buffer,
-    /// How many lights `lights` holds room for.
-    pub light_capacity: usize,
     /// The frame uniform.
     pub frame: wgpu::Buffer,
 }
@@ -175,6 +175,21 @@ fn mesh(gpu: &GpuContext, label: &str, vertices: &[crate::scene_geometry::Vertex
             }),
         vertices: vertices.len() as u32,
     }
+}
+
+/// Most lights a scene frame draws, each with its shadow: the lights are a uniform array of this
+/// many (`gpu_scene.wgsl`, 48 KiB, under the 64 KiB every backend allows). On lavapipe a uniform
+/// array is read at half the cost of a storage buffer (BENCHMARKS.md, "Viewer").
+pub const MAX_SHADOWED_LIGHTS: usize = 256;
+
+/// The lights' uniform buffer, zeroed.
+fn lights_buffer(gpu: &GpuContext) -> wgpu::Buffer {
+    gpu.device
+        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("lights"),
+            contents: bytemuck::cast_slice(&[GpuLight::zeroed(); MAX_SHADOWED_LIGHTS]),
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        })
 }
 
 fn storage(gpu: &GpuContext, label: &str, bytes: &[u8]) -> wgpu::Buffer {
@@ -211,8 +226,7 @@ impl GpuScene {
                 .collect(),
             materials: storage(gpu, "materials", bytemuck::cast_slice(&materials)),
             transforms: storage(gpu, "objects", bytemuck::cast_slice(&transforms)),
-            lights: storage(gpu, "lights", bytemuck::bytes_of(&GpuLight::zeroed())),
-            light_capacity: 1,
+            lights: lights_buffer(gpu),
             frame: gpu.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("frame"),
                 size: std::mem::size_of::<FrameUniform>() as u64,
@@ -222,22 +236,13 @@ impl GpuScene {
         }
     }
 
-    /// Writes the lights, growing the buffer when needed; true when it was replaced (bind
-    /// groups must then be rebuilt).
-    pub fn write_lights(&mut self, gpu: &GpuContext, lights: &[GpuLight]) -> bool {
-        let data: Vec<GpuLight> = if lights.is_empty() {
-            vec![GpuLight::zeroed()]
-        } else {
-            lights.to_vec()
-        };
-        if data.len() > self.light_capacity {
-            self.lights = storage(gpu, "lights", bytemuck::cast_slice(&data));
-            self.light_capacity = data.len();
-            return true;
+    /// Writes the lights (the first [`MAX_SHADOWED_LIGHTS`]; `lighting.rs` refuses more).
+    pub fn write_lights(&self, gpu: &GpuContext, lights: &[GpuLight]) {
+        let lights = &lights[..lights.len().min(MAX_SHADOWED_LIGHTS)];
+        if !lights.is_empty() {
+            gpu.queue
+                .write_buffer(&self.lights, 0, bytemuck::cast_slice(lights));
         }
-        gpu.queue
-            .write_buffer(&self.lights, 0, bytemuck::cast_slice(&data));
-        false
     }
 
     /// Writes the object transforms (real first).
@@ -269,10 +274,18 @@ mod tests {
     #[test]
     fn structs_match_their_wgsl_sizes() {
         // Sums of the WGSL members (all 16-byte columns): no padding on either side.
-        assert_eq!(std::mem::size_of::<FrameUniform>(), 3 * 64 + 8 * 16);
+        assert_eq!(std::mem::size_of::<FrameUniform>(), 3 * 64 + 9 * 16);
         assert_eq!(std::mem::size_of::<GpuLight>(), 2 * 64 + 6 * 16);
         assert_eq!(std::mem::size_of::<GpuObject>(), 2 * 64 + 16);
         assert_eq!(std::mem::size_of::<GpuMaterial>(), 32);
         assert_eq!(std::mem::size_of::<crate::scene_geometry::Vertex>(), 28);
+    }
+
+    #[test]
+    fn the_shaders_light_array_has_the_rust_length_and_fits_a_uniform_binding() {
+        let declared = format!("const MAX_SHADOWED_LIGHTS: u32 = {MAX_SHADOWED_LIGHTS}u;");
+        assert!(include_str!("gpu_scene.wgsl").contains(&declared));
+        // 64 KiB: the uniform binding size every wgpu backend allows (WebGPU's default limit).
+        assert!(std::mem::size_of::<GpuLight>() * MAX_SHADOWED_LIGHTS <= 1 << 16);
     }
 }

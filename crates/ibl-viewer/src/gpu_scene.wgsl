@@ -17,7 +17,8 @@ struct Frame {
     // width, height, 1 / width, 1 / height.
     viewport: vec4<f32>,
     // light count, composite rule (0 difference, 1 ratio), shadows (0 hard, 1 soft),
-    // background (0 panorama, 1 photo).
+    // background (0 panorama, 1 photo). The scene pass reads only the count: it takes the
+    // others (and options.x to z) as pipeline constants (scene_pass.rs, ShaderVariant).
     counts: vec4<u32>,
     // glossy source (0 the lights, 1 the prefiltered probe), ambient (0 none, 1 the SH map),
     // background rays per pixel axis, frame number.
@@ -26,7 +27,12 @@ struct Frame {
     environment: vec4<f32>,
     // real atlas width, height; virtual atlas width, height (texels).
     atlas: vec4<f32>,
+    // The flat real layer's plane (n, d), n . p + d = 0; zero when the real layer is not flat.
+    real_plane: vec4<f32>,
 };
+
+// Lights a frame draws (gpu_scene.rs's MAX_SHADOWED_LIGHTS): a uniform array of this many.
+const MAX_SHADOWED_LIGHTS: u32 = 256u;
 
 struct Light {
     // xyz: unit direction towards the light; w: tan of the half-angle of its cone.

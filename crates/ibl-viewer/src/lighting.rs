@@ -67,6 +67,14 @@ pub fn scene_lighting(request: &SceneLightingRequest) -> Result<SceneLighting, S
         ),
         Illumination::Environment => return Err("the reference mode has no lights".into()),
     };
+    if list.lights.len() > crate::gpu_scene::MAX_SHADOWED_LIGHTS {
+        return Err(format!(
+            "{} lights: the scene viewer draws at most {} shadowed lights (lower -n or the \
+             scene's [lighting] lights)",
+            list.lights.len(),
+            crate::gpu_scene::MAX_SHADOWED_LIGHTS
+        ));
+    }
     let plan = &request.plan;
     let mut summary = format!(
         "{} {} lights",

@@ -128,8 +128,72 @@ impl SceneGeometry {
         }
     }
 
+    /// The plane of the real geometry when every real triangle lies in one plane (the ground of
+    /// most AR scenes): `(n, d)` with `n . p + d = 0` on it, `n` a unit vector; `None` when the
+    /// real geometry is empty or not flat (within 1e-5 of its extent). A flat real layer
+    /// cannot shadow a point on the side of the plane that a light shines from: the scene pass
+    /// skips its real shadow look-up there (`shadow_lookup.wgsl`).
+    pub fn real_plane(&self) -> Option<(Vec3, f32)> {
+        let v = &self.real.vertices;
+        let (lo, hi) = self.real_bounds()?;
+        let tolerance = 1e-5 * (hi - lo).length().max(1e-6);
+        let corner = |k: usize| Vec3::from(v[k].position);
+        // The normal of the largest triangle (the best conditioned).
+        let normal = (0..v.len() / 3)
+            .map(|t| (corner(3 * t + 1) - corner(3 * t)).cross(corner(3 * t + 2) - corner(3 * t)))
+            .max_by(|a, b| a.length_squared().total_cmp(&b.length_squared()))?
+            .try_normalize()?;
+        let d = -normal.dot(corner(0));
+        v.iter()
+            .all(|x| (normal.dot(Vec3::from(x.position)) + d).abs() <= tolerance)
+            .then_some((normal, d))
+    }
+
     /// Bounds of the real geometry at load; `None` when there is none.
     pub fn real_bounds(&self) -> Option<(Vec3, Vec3)> {
         (!self.real.vertices.is_empty()).then_some(self.real.bounds)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn geometry(corners: &[[f32; 3]]) -> SceneGeometry {
+        let vertices = corners
+            .iter()
+            .map(|&position| Vertex {
+                position,
+                normal: [0.0, 1.0, 0.0],
+                material: 0,
+            })
+            .collect();
+        SceneGeometry {
+            real: object("real".into(), vertices),
+            objects: Vec::new(),
+            materials: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn a_ground_of_two_triangles_is_flat_and_a_bent_one_is_not() {
+        let (a, b, c, d) = (
+            [-20.0, -1.0, -20.0],
+            [20.0, -1.0, -20.0],
+            [20.0, -1.0, 20.0],
+            [-20.0, -1.0, 20.0],
+        );
+        let (n, offset) = geometry(&[a, b, c, a, c, d]).real_plane().unwrap();
+        assert!((n.y.abs() - 1.0).abs() < 1e-6 && n.x.abs() < 1e-6 && n.z.abs() < 1e-6);
+        // n . p + d = 0 at y = -1.
+        assert!((n.y * -1.0 + offset).abs() < 1e-5);
+        // One corner lifted by 1 mm over a 57 m diagonal is more than 1e-5 of the extent.
+        let lifted = [20.0, -0.999, 20.0];
+        assert!(
+            geometry(&[a, b, lifted, a, lifted, d])
+                .real_plane()
+                .is_none()
+        );
+        assert!(geometry(&[]).real_plane().is_none());
     }
 }

@@ -1,6 +1,14 @@
 //! The scene pass (`scene_pass.wgsl`): virtual objects and local geometry lit by the lights with
 //! their shadows, composited into the background by differential rendering, 4x multisampled.
 //! See the shader's notes for the composite and `shadow_atlas.rs` for the shadows.
+//!
+//! The scene's fixed choices (hard or soft shadows, composite rule, background kind, glossy
+//! source, ambient, background rays) are pipeline-overridable constants, one pipeline pair per
+//! [`ShaderVariant`], built the first time a frame needs it: a shader that branches on a uniform
+//! keeps every branch, which on lavapipe made the hard-shadow frame 4 to 5 times slower than the
+//! same shader with the soft branch compiled away (BENCHMARKS.md, "Viewer").
+
+use std::collections::HashMap;
 
 use crate::environment_maps::EnvironmentMaps;
 use crate::frame_targets::{COVERAGE_FORMAT, FrameTargets, MSAA_SAMPLES};
@@ -10,11 +18,65 @@ use crate::scene_geometry::{VERTEX_ATTRIBUTES, Vertex};
 use crate::shadow_atlas::ShadowAtlases;
 use crate::textures::HdrTexture;
 
+/// The per-scene choices compiled into a scene pass pipeline (the shader's `override`s).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct ShaderVariant {
+    /// PCSS soft shadows (else one hard tap).
+    pub soft_shadows: bool,
+    /// The ratio composite rule (else the difference rule).
+    pub ratio_rule: bool,
+    /// A background photograph (else the panorama).
+    pub photo_background: bool,
+    /// Glossy lobes from the prefiltered probe (else from the lights).
+    pub glossy_from_probe: bool,
+    /// The hybrid ambient map is bound.
+    pub has_ambient: bool,
+    /// Background rays per pixel axis, 1 to 8.
+    pub background_rays: u32,
+    /// The real geometry lies in one plane (`FrameUniform::real_plane`).
+    pub flat_real_layer: bool,
+}
+
+impl ShaderVariant {
+    fn constants(&self) -> [(&'static str, f64); 7] {
+        let flag = |b: bool| if b { 1.0 } else { 0.0 };
+        [
+            ("SOFT_SHADOWS", flag(self.soft_shadows)),
+            ("RATIO_RULE", flag(self.ratio_rule)),
+            ("PHOTO_BACKGROUND", flag(self.photo_background)),
+            ("GLOSSY_FROM_PROBE", flag(self.glossy_from_probe)),
+            ("HAS_AMBIENT", flag(self.has_ambient)),
+            (
+                "BACKGROUND_RAYS",
+                f64::from(self.background_rays.clamp(1, 8)),
+            ),
+            ("FLAT_REAL_LAYER", flag(self.flat_real_layer)),
+        ]
+    }
+}
+
+/// The scene's vertices as `vs_geometry` reads them.
+fn vertex_buffer_layout() -> wgpu::VertexBufferLayout<'static> {
+    wgpu::VertexBufferLayout {
+        array_stride: std::mem::size_of::<Vertex>() as u64,
+        step_mode: wgpu::VertexStepMode::Vertex,
+        attributes: &VERTEX_ATTRIBUTES,
+    }
+}
+
+/// The geometry and sky pipelines of one variant.
+#[derive(Debug)]
+struct VariantPipelines {
+    geometry: wgpu::RenderPipeline,
+    sky: wgpu::RenderPipeline,
+}
+
 /// Pipelines and samplers of the scene pass.
 #[derive(Debug)]
 pub struct ScenePass {
-    geometry: wgpu::RenderPipeline,
-    sky: wgpu::RenderPipeline,
+    module: wgpu::ShaderModule,
+    pipeline_layout: wgpu::PipelineLayout,
+    pipelines: HashMap<ShaderVariant, VariantPipelines>,
     layout: wgpu::BindGroupLayout,
     probe_sampler: wgpu::Sampler,
     shadow_sampler: wgpu::Sampler,
@@ -74,7 +136,7 @@ impl ScenePass {
             label: Some("scene pass"),
             entries: &[
                 buffer(0, wgpu::BufferBindingType::Uniform),
-                buffer(1, storage),
+                buffer(1, wgpu::BufferBindingType::Uniform),
                 buffer(2, storage),
                 buffer(3, storage),
                 texture(4, filterable),
@@ -102,6 +164,34 @@ impl ScenePass {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
+        ScenePass {
+            module,
+            pipeline_layout,
+            pipelines: HashMap::new(),
+            layout,
+            probe_sampler: device.create_sampler(&crate::textures::probe_sampler_descriptor()),
+            shadow_sampler: device.create_sampler(&wgpu::SamplerDescriptor {
+                label: Some("shadow comparison"),
+                mag_filter: wgpu::FilterMode::Linear,
+                min_filter: wgpu::FilterMode::Linear,
+                compare: Some(wgpu::CompareFunction::LessEqual),
+                ..Default::default()
+            }),
+        }
+    }
+
+    /// Builds the pipelines of `variant` unless they exist (the first frame of a scene, or after
+    /// a setting changed; lavapipe compiles the shader then).
+    pub fn prepare(&mut self, gpu: &GpuContext, variant: ShaderVariant) {
+        if self.pipelines.contains_key(&variant) {
+            return;
+        }
+        let device = &gpu.device;
+        let constants = variant.constants();
+        let options = wgpu::PipelineCompilationOptions {
+            constants: &constants,
+            ..Default::default()
+        };
         let targets = [
             Some(wgpu::ColorTargetState::from(HDR_FORMAT)),
             Some(wgpu::ColorTargetState::from(COVERAGE_FORMAT)),
@@ -110,18 +200,14 @@ impl ScenePass {
             count: MSAA_SAMPLES,
             ..Default::default()
         };
-        let vertex_layout = [Some(wgpu::VertexBufferLayout {
-            array_stride: std::mem::size_of::<Vertex>() as u64,
-            step_mode: wgpu::VertexStepMode::Vertex,
-            attributes: &VERTEX_ATTRIBUTES,
-        })];
+        let vertex_layout = [Some(vertex_buffer_layout())];
         let geometry = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("scene geometry"),
-            layout: Some(&pipeline_layout),
+            layout: Some(&self.pipeline_layout),
             vertex: wgpu::VertexState {
-                module: &module,
+                module: &self.module,
                 entry_point: Some("vs_geometry"),
-                compilation_options: Default::default(),
+                compilation_options: options.clone(),
                 buffers: &vertex_layout,
             },
             primitive: wgpu::PrimitiveState {
@@ -138,9 +224,9 @@ impl ScenePass {
             }),
             multisample,
             fragment: Some(wgpu::FragmentState {
-                module: &module,
+                module: &self.module,
                 entry_point: Some("fs_geometry"),
-                compilation_options: Default::default(),
+                compilation_options: options.clone(),
                 targets: &targets,
             }),
             multiview_mask: None,
@@ -148,11 +234,11 @@ impl ScenePass {
         });
         let sky = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("scene sky"),
-            layout: Some(&pipeline_layout),
+            layout: Some(&self.pipeline_layout),
             vertex: wgpu::VertexState {
-                module: &module,
+                module: &self.module,
                 entry_point: Some("vs_sky"),
-                compilation_options: Default::default(),
+                compilation_options: options.clone(),
                 buffers: &[],
             },
             primitive: wgpu::PrimitiveState::default(),
@@ -165,27 +251,16 @@ impl ScenePass {
             }),
             multisample,
             fragment: Some(wgpu::FragmentState {
-                module: &module,
+                module: &self.module,
                 entry_point: Some("fs_sky"),
-                compilation_options: Default::default(),
+                compilation_options: options.clone(),
                 targets: &targets,
             }),
             multiview_mask: None,
             cache: None,
         });
-        ScenePass {
-            geometry,
-            sky,
-            layout,
-            probe_sampler: device.create_sampler(&crate::textures::probe_sampler_descriptor()),
-            shadow_sampler: device.create_sampler(&wgpu::SamplerDescriptor {
-                label: Some("shadow comparison"),
-                mag_filter: wgpu::FilterMode::Linear,
-                min_filter: wgpu::FilterMode::Linear,
-                compare: Some(wgpu::CompareFunction::LessEqual),
-                ..Default::default()
-            }),
-        }
+        self.pipelines
+            .insert(variant, VariantPipelines { geometry, sky });
     }
 
     /// The bind group of a scene and its inputs (rebuild when a buffer or texture is replaced).
@@ -252,9 +327,11 @@ impl ScenePass {
         })
     }
 
-    /// Records the pass into `targets` (MSAA targets resolved into `radiance` and `coverage`).
+    /// Records the pass into `targets` (MSAA targets resolved into `radiance` and `coverage`)
+    /// with the pipelines of `variant` ([`ScenePass::prepare`]d; nothing is drawn otherwise).
     pub fn record(
         &self,
+        variant: ShaderVariant,
         encoder: &mut wgpu::CommandEncoder,
         targets: &FrameTargets,
         scene: &GpuScene,
@@ -265,6 +342,9 @@ impl ScenePass {
             load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
             // The samples are resolved into the single-sample targets; they need not be kept.
             store: wgpu::StoreOp::Discard,
+        };
+        let Some(pipelines) = self.pipelines.get(&variant) else {
+            return;
         };
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("scene"),
@@ -295,20 +375,25 @@ impl ScenePass {
             multiview_mask: None,
         });
         pass.set_bind_group(0, bind_group, &[]);
-        pass.set_pipeline(&self.geometry);
-        if scene.real.vertices > 0 {
-            pass.set_vertex_buffer(0, scene.real.buffer.slice(..));
-            pass.draw(0..scene.real.vertices, 0..1);
-        }
-        for (k, mesh) in scene.objects.iter().enumerate() {
-            if mesh.vertices == 0 {
-                continue;
-            }
-            let object = k as u32 + 1;
-            pass.set_vertex_buffer(0, mesh.buffer.slice(..));
-            pass.draw(0..mesh.vertices, object..object + 1);
-        }
-        pass.set_pipeline(&self.sky);
+        pass.set_pipeline(&pipelines.geometry);
+        draw_geometry(&mut pass, scene);
+        pass.set_pipeline(&pipelines.sky);
         pass.draw(0..3, 0..1);
+    }
+}
+
+/// Draws the real geometry (instance 0) and each virtual object (instance k + 1).
+fn draw_geometry(pass: &mut wgpu::RenderPass<'_>, scene: &GpuScene) {
+    if scene.real.vertices > 0 {
+        pass.set_vertex_buffer(0, scene.real.buffer.slice(..));
+        pass.draw(0..scene.real.vertices, 0..1);
+    }
+    for (k, mesh) in scene.objects.iter().enumerate() {
+        if mesh.vertices == 0 {
+            continue;
+        }
+        let object = k as u32 + 1;
+        pass.set_vertex_buffer(0, mesh.buffer.slice(..));
+        pass.draw(0..mesh.vertices, object..object + 1);
     }
 }

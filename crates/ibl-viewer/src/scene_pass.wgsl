@@ -22,7 +22,7 @@
 // alpha, the CPU renderer's `object_coverage`.
 
 @group(0) @binding(0) var<uniform> frame: Frame;
-@group(0) @binding(1) var<storage, read> lights: array<Light>;
+@group(0) @binding(1) var<uniform> lights: array<Light, MAX_SHADOWED_LIGHTS>;
 @group(0) @binding(2) var<storage, read> objects: array<Object>;
 @group(0) @binding(3) var<storage, read> materials: array<Material>;
 @group(0) @binding(4) var probe: texture_2d<f32>;
@@ -36,12 +36,29 @@
 
 const PI: f32 = 3.14159265358979;
 
+// Per-scene choices as pipeline constants (scene_pass.rs's `ShaderVariant`): a pipeline holds
+// only the code its scene runs. On a software rasterizer (lavapipe) a branch on a uniform keeps
+// both sides in the compiled shader and costs several times the side taken (BENCHMARKS.md,
+// "Viewer"); a constant branch is compiled away.
+// Composite by the ratio rule (else the difference rule).
+override RATIO_RULE: bool = false;
+// The background is a photograph (else the panorama).
+override PHOTO_BACKGROUND: bool = false;
+// Glossy lobes reflect the prefiltered probe (else the lights light them).
+override GLOSSY_FROM_PROBE: bool = false;
+// The hybrid ambient's irradiance map is bound.
+override HAS_AMBIENT: bool = false;
+// Background rays per pixel axis (1 to 8).
+override BACKGROUND_RAYS: u32 = 4u;
+
 struct GeometryOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) world: vec3<f32>,
     @location(1) normal: vec3<f32>,
     @location(2) @interpolate(flat) material: u32,
-    @location(3) @interpolate(flat) object: u32,
+    // 1 on virtual objects, 0 on real geometry (the object's layer, passed on so that the
+    // fragment does not read the object's record again).
+    @location(3) @interpolate(flat) layer: u32,
 };
 
 struct FragmentOut {
@@ -58,7 +75,7 @@ fn vs_geometry(vertex: Vertex, @builtin(instance_index) object: u32) -> Geometry
     out.world = world.xyz;
     out.normal = (o.normal_from_load * vec4<f32>(vertex.normal, 0.0)).xyz;
     out.material = vertex.material;
-    out.object = object;
+    out.layer = o.flags.x;
     return out;
 }
 
@@ -105,10 +122,10 @@ fn photo_pixel(pixel: vec2<f32>) -> vec3<f32> {
 
 // B seen through the pixel at `pixel` (its top-left corner is floor(pixel)) along camera rays.
 fn background_sky(pixel: vec2<f32>) -> vec3<f32> {
-    if frame.counts.w == 1u {
+    if PHOTO_BACKGROUND {
         return photo_pixel(pixel);
     }
-    let n = max(frame.options.z, 1u);
+    let n = BACKGROUND_RAYS;
     let corner = floor(pixel);
     var sum = vec3<f32>(0.0);
     for (var sy = 0u; sy < n; sy = sy + 1u) {
@@ -122,10 +139,10 @@ fn background_sky(pixel: vec2<f32>) -> vec3<f32> {
 
 // B on a real surface point p, with its screen derivatives, seen from the probe's centre.
 fn background_surface(pixel: vec2<f32>, p: vec3<f32>, dx: vec3<f32>, dy: vec3<f32>) -> vec3<f32> {
-    if frame.counts.w == 1u {
+    if PHOTO_BACKGROUND {
         return photo_pixel(pixel);
     }
-    let n = max(frame.options.z, 1u);
+    let n = BACKGROUND_RAYS;
     // The fragment is shaded at the pixel centre; sub-pixel offsets from there.
     let centre = pixel - floor(pixel);
     var sum = vec3<f32>(0.0);
@@ -164,7 +181,7 @@ fn reflection(m: Material, ns: vec3<f32>, ng: vec3<f32>, wo: vec3<f32>, wi: vec3
 
 // E(n) of the hybrid ambient (world-frame lat-long map).
 fn ambient_irradiance(n: vec3<f32>) -> vec3<f32> {
-    if frame.options.y == 0u {
+    if !HAS_AMBIENT {
         return vec3<f32>(0.0);
     }
     return textureSampleLevel(ambient, probe_sampler, dir_to_uv(n), 0.0).rgb * frame.environment.w;
@@ -203,7 +220,44 @@ fn facing(in_normal: vec3<f32>, dx: vec3<f32>, dy: vec3<f32>, wo: vec3<f32>, fro
     return out;
 }
 
-fn shade_virtual(m: Material, p: vec3<f32>, f: SurfaceFrame, wo: vec3<f32>, pixel_noise: f32) -> vec3<f32> {
+// What the lights give a surface point: on a virtual object its direct light (each light's
+// shadow from both layers), on a real surface the change the virtual objects make,
+// `with - without` over the lights they block.
+struct LightSums {
+    direct: vec3<f32>,
+    change: vec3<f32>,
+    affected: bool,
+};
+
+// One loop over the lights for both layers, so that the shadow look-ups are compiled once
+// (on lavapipe the size of the shader costs as much as the work it does: BENCHMARKS.md).
+fn light_sums(m: Material, p: vec3<f32>, f: SurfaceFrame, wo: vec3<f32>, on_virtual: bool, pixel_noise: f32) -> LightSums {
+    var sums = LightSums(vec3<f32>(0.0), vec3<f32>(0.0), false);
+    // Real surfaces take their glossy lobe from the lights (ibl-render's rule).
+    let with_lobe = !on_virtual || !GLOSSY_FROM_PROBE;
+    let count = frame.counts.x;
+    for (var i = 0u; i < count; i = i + 1u) {
+        let wi = lights[i].direction.xyz;
+        let fc = reflection(m, f.ns, f.ng, wo, wi, with_lobe);
+        if all(fc <= vec3<f32>(0.0)) {
+            continue;
+        }
+        let vv = virtual_visibility(i, p, f.ng, pixel_noise);
+        if on_virtual || vv < 1.0 {
+            let e = fc * lights[i].irradiance.rgb * real_visibility(i, p, f.ng, pixel_noise);
+            if on_virtual {
+                sums.direct = sums.direct + e * vv;
+            } else {
+                sums.affected = true;
+                sums.change = sums.change + e * (vv - 1.0);
+            }
+        }
+    }
+    return sums;
+}
+
+// A virtual object's radiance from its lights' sums (mirrors reflect the probe instead).
+fn shade_virtual(m: Material, f: SurfaceFrame, wo: vec3<f32>, sums: LightSums) -> vec3<f32> {
     let kind = u32(m.albedo_kind.w);
     let ns = f.ns;
     if kind == 2u {
@@ -211,20 +265,8 @@ fn shade_virtual(m: Material, p: vec3<f32>, f: SurfaceFrame, wo: vec3<f32>, pixe
         let r = 2.0 * dot(wo, ns) * ns - wo;
         return m.specular_exponent.rgb * probe_filtered(probe, r, 0.0);
     }
-    let lobe_from_lights = frame.options.x == 0u;
-    var radiance = vec3<f32>(0.0);
-    let count = frame.counts.x;
-    for (var i = 0u; i < count; i = i + 1u) {
-        let wi = lights[i].direction.xyz;
-        let fc = reflection(m, ns, f.ng, wo, wi, lobe_from_lights);
-        if all(fc <= vec3<f32>(0.0)) {
-            continue;
-        }
-        let v = real_visibility(i, p, f.ng, pixel_noise) * virtual_visibility(i, p, f.ng, pixel_noise);
-        radiance = radiance + fc * lights[i].irradiance.rgb * v;
-    }
-    radiance = radiance + m.albedo_kind.rgb / PI * ambient_irradiance(ns);
-    if kind == 1u && !lobe_from_lights {
+    var radiance = sums.direct + m.albedo_kind.rgb / PI * ambient_irradiance(ns);
+    if kind == 1u && GLOSSY_FROM_PROBE {
         // The glossy lobe reflecting the prefiltered probe (environment_maps.rs).
         let r = 2.0 * dot(wo, ns) * ns - wo;
         let e = m.specular_exponent.w;
@@ -236,31 +278,16 @@ fn shade_virtual(m: Material, p: vec3<f32>, f: SurfaceFrame, wo: vec3<f32>, pixe
 }
 
 // The composite on a real surface (module notes).
-fn composite_real(m: Material, p: vec3<f32>, f: SurfaceFrame, wo: vec3<f32>, b: vec3<f32>, pixel_noise: f32) -> vec3<f32> {
-    let count = frame.counts.x;
-    // with - without: only lights the virtual objects block change anything.
-    var change = vec3<f32>(0.0);
-    var affected = false;
-    for (var i = 0u; i < count; i = i + 1u) {
-        let wi = lights[i].direction.xyz;
-        let fc = reflection(m, f.ns, f.ng, wo, wi, true);
-        if all(fc <= vec3<f32>(0.0)) {
-            continue;
-        }
-        let vv = virtual_visibility(i, p, f.ng, pixel_noise);
-        if vv < 1.0 {
-            affected = true;
-            let vr = real_visibility(i, p, f.ng, pixel_noise);
-            change = change + fc * lights[i].irradiance.rgb * (vr * (vv - 1.0));
-        }
-    }
-    if !affected {
+fn composite_real(m: Material, p: vec3<f32>, f: SurfaceFrame, wo: vec3<f32>, b: vec3<f32>, sums: LightSums, pixel_noise: f32) -> vec3<f32> {
+    let change = sums.change;
+    if !sums.affected {
         return b;
     }
-    if frame.counts.y == 0u {
+    if !RATIO_RULE {
         return max(b + change, vec3<f32>(0.0));
     }
     var without = m.albedo_kind.rgb / PI * ambient_irradiance(f.ns);
+    let count = frame.counts.x;
     for (var i = 0u; i < count; i = i + 1u) {
         let wi = lights[i].direction.xyz;
         let fc = reflection(m, f.ns, f.ng, wo, wi, true);
@@ -288,19 +315,19 @@ fn fs_geometry(in: GeometryOut, @builtin(front_facing) front: bool) -> FragmentO
     // Derivatives first, in uniform control flow.
     let dx = dpdx(in.world);
     let dy = dpdy(in.world);
-    let o = objects[in.object];
     let m = materials[in.material];
     let wo = normalize(frame.camera_position.xyz - in.world);
     let f = facing(in.normal, dx, dy, wo, front);
     let pixel = in.clip.xy;
     let pixel_noise = noise(floor(pixel));
+    let sums = light_sums(m, in.world, f, wo, in.layer == 1u, pixel_noise);
     var out: FragmentOut;
-    if o.flags.x == 1u {
-        out.radiance = vec4<f32>(shade_virtual(m, in.world, f, wo, pixel_noise), 1.0);
+    if in.layer == 1u {
+        out.radiance = vec4<f32>(shade_virtual(m, f, wo, sums), 1.0);
         out.coverage = vec4<f32>(1.0, 0.0, 0.0, 1.0);
     } else {
         let b = background_surface(pixel, in.world, dx, dy);
-        out.radiance = vec4<f32>(composite_real(m, in.world, f, wo, b, pixel_noise), 1.0);
+        out.radiance = vec4<f32>(composite_real(m, in.world, f, wo, b, sums, pixel_noise), 1.0);
         out.coverage = vec4<f32>(0.0, 0.0, 0.0, 1.0);
     }
     return out;

@@ -18,7 +18,7 @@ use crate::gpu::GpuContext;
 use crate::gpu_scene::{FrameUniform, GpuLight, GpuObject, GpuScene, mat3_columns, vec4};
 use crate::lighting::SceneLighting;
 use crate::scene_model::SceneModel;
-use crate::scene_pass::{ScenePass, ScenePassInputs};
+use crate::scene_pass::{ScenePass, ScenePassInputs, ShaderVariant};
 use crate::shadow_atlas::ShadowAtlases;
 use crate::textures::{HdrTexture, black_texture, upload_hdr};
 use crate::timing::{PassTimer, PassTimes, SCENE_PASSES};
@@ -280,6 +280,23 @@ impl SceneRenderer {
                 self.ambient.scale,
             ],
             atlas: [rw as f32, rh as f32, vw as f32, vh as f32],
+            real_plane: model
+                .geometry
+                .real_plane()
+                .map_or([0.0; 4], |(n, d)| [n.x, n.y, n.z, d]),
+        }
+    }
+
+    /// The pipeline constants of a frame of `model` drawn with `settings`.
+    fn shader_variant(&self, model: &SceneModel, settings: &SceneFrameSettings) -> ShaderVariant {
+        ShaderVariant {
+            soft_shadows: model.description.lighting.shadows == ibl_scene::ShadowKind::Soft,
+            ratio_rule: model.description.render.composite == CompositeRule::Ratio,
+            photo_background: matches!(model.scene.background, Background::Photo(_)),
+            glossy_from_probe: settings.glossy == GlossySource::Environment,
+            has_ambient: self.lighting.as_ref().is_some_and(|l| l.ambient.is_some()),
+            background_rays: settings.background_rays.clamp(1, 8),
+            flat_real_layer: model.geometry.real_plane().is_some(),
         }
     }
 
@@ -326,9 +343,7 @@ impl SceneRenderer {
                 model.geometry.real_bounds(),
             );
             draw_real |= region_moved;
-            if self.gpu_scene.write_lights(gpu, &gpu_lights) {
-                self.rebind(gpu);
-            }
+            self.gpu_scene.write_lights(gpu, &gpu_lights);
             self.gpu_lights = gpu_lights;
         }
         let mut objects = vec![GpuObject::new(Affine3A::IDENTITY, false, false)];
@@ -341,6 +356,8 @@ impl SceneRenderer {
         self.gpu_scene.write_transforms(gpu, &objects);
         let uniform = self.frame_uniform(model, settings, count);
         self.gpu_scene.write_frame(gpu, &uniform);
+        let variant = self.shader_variant(model, settings);
+        self.scene_pass.prepare(gpu, variant);
 
         let mut encoder = gpu
             .device
@@ -361,6 +378,7 @@ impl SceneRenderer {
         {
             let t = self.timer.as_mut().and_then(|t| t.writes(2));
             self.scene_pass.record(
+                variant,
                 &mut encoder,
                 &self.targets,
                 &self.gpu_scene,

@@ -161,7 +161,14 @@ impl ShadowAtlases {
                         min_binding_size: None,
                     },
                 ),
-                entry(1, storage),
+                entry(
+                    1,
+                    wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                ),
                 entry(2, storage),
             ],
         });

@@ -8,7 +8,7 @@
 // atlas needs no clipping against tile borders.
 
 @group(0) @binding(0) var<uniform> frame: Frame;
-@group(0) @binding(1) var<storage, read> lights: array<Light>;
+@group(0) @binding(1) var<uniform> lights: array<Light, MAX_SHADOWED_LIGHTS>;
 @group(0) @binding(2) var<storage, read> objects: array<Object>;
 
 @vertex

@@ -10,19 +10,21 @@
 // covers more depth per texel, so a constant bias leaves acne near the terminator.
 // Soft shadows (PCSS, Fernando 2005): a directional light of cone half-angle a casts a penumbra
 // `(d_receiver - d_blocker) tan a` wide; the mean blocker depth comes from 12 taps over the
-// widest penumbra possible, the visibility from 16 comparison taps over that penumbra, rotated
-// per pixel, both with a receiver-plane bias (below).
+// widest penumbra possible, the visibility from 16 comparison taps over that penumbra, both on
+// a Vogel disk (golden-angle spiral) rotated per pixel, with a receiver-plane bias (below).
+//
+// Written for software rasterizers as much as for GPUs: lavapipe runs this code on the CPU,
+// where a constant array indexed in a loop becomes a per-pixel copy in memory and a function
+// that holds both the hard and the soft look-up costs the hard one 3 to 5 times its own time
+// (measured, BENCHMARKS.md "Viewer"). So the taps are generated, not read from a table, the
+// hard look-up is its own function, and each light's fields are read one by one, not copied.
 
-const POISSON: array<vec2<f32>, 16> = array<vec2<f32>, 16>(
-    vec2<f32>(-0.94201624, -0.39906216), vec2<f32>(0.94558609, -0.76890725),
-    vec2<f32>(-0.09418410, -0.92938870), vec2<f32>(0.34495938, 0.29387760),
-    vec2<f32>(-0.91588581, 0.45771432), vec2<f32>(-0.81544232, -0.87912464),
-    vec2<f32>(-0.38277543, 0.27676845), vec2<f32>(0.97484398, 0.75648379),
-    vec2<f32>(0.44323325, -0.97511554), vec2<f32>(0.53742981, -0.47373420),
-    vec2<f32>(-0.26496911, -0.41893023), vec2<f32>(0.79197514, 0.19090188),
-    vec2<f32>(-0.24188840, 0.99706507), vec2<f32>(-0.81409955, 0.91437590),
-    vec2<f32>(0.19984126, 0.78641367), vec2<f32>(0.14383161, -0.14100790)
-);
+// Soft (PCSS) or hard shadows: a pipeline constant (scene_pass.rs), so each pipeline holds
+// only the look-up it runs.
+override SOFT_SHADOWS: bool = false;
+
+// The golden angle's rotation, (cos, sin) of pi (3 - sqrt 5).
+const GOLDEN: vec2<f32> = vec2<f32>(-0.7373688, 0.6754903);
 
 // Tile coordinates (x, y in [-1, 1], +y up) to atlas texture coordinates.
 fn tile_uv(tile: vec4<f32>, xy: vec2<f32>) -> vec2<f32> {
@@ -34,36 +36,54 @@ fn clamp_to_tile(uv: vec2<f32>, tile: vec4<f32>, texel_uv: vec2<f32>) -> vec2<f3
     return clamp(uv, tile.xy + 0.5 * texel_uv, tile.xy + tile.zw - 0.5 * texel_uv);
 }
 
-// Visibility (0 shadowed, 1 lit) of a light in one atlas at world point `p` with unit normal
-// `n` (on the lit side). `extent` = (half extent, depth range, texel size) in world units.
-fn atlas_visibility(
-    atlas: texture_depth_2d,
-    map: mat4x4<f32>,
-    tile: vec4<f32>,
-    extent: vec4<f32>,
-    atlas_size: vec2<f32>,
-    tan_half: f32,
-    soft: bool,
-    p: vec3<f32>,
-    n: vec3<f32>,
-    cos_light: f32,
-    noise: f32,
-) -> f32 {
+// Where a receiver at world point `p` with unit normal `n` (lit side) falls in a light's tile:
+// xy in [-1, 1] inside it, z its depth in [0, 1]; `extent` = (half extent, depth range, texel
+// size) in world units. Normal offset and slope-scaled depth bias against self-shadowing.
+struct TileHit {
+    inside: bool,
+    uv: vec2<f32>,
+    depth: f32,
+    slope: f32,
+};
+
+fn tile_hit(map: mat4x4<f32>, tile: vec4<f32>, extent: vec4<f32>, p: vec3<f32>, n: vec3<f32>, cos_light: f32) -> TileHit {
     let texel_world = extent.z;
     let cos_t = clamp(cos_light, 0.01, 1.0);
     let sin_t = sqrt(1.0 - cos_t * cos_t);
-    let slope = min(sin_t / cos_t, 4.0);
+    var hit: TileHit;
+    hit.slope = min(sin_t / cos_t, 4.0);
     let q = map * vec4<f32>(p + n * ((1.5 + 2.0 * sin_t) * texel_world), 1.0);
     // Outside the tile (no caster projects there) or in front of every caster: lit.
-    if abs(q.x) >= 1.0 || abs(q.y) >= 1.0 || q.z <= 0.0 {
+    hit.inside = abs(q.x) < 1.0 && abs(q.y) < 1.0 && q.z > 0.0;
+    hit.depth = min(q.z, 1.0) - (1.0 + 2.0 * hit.slope) * texel_world / extent.y;
+    hit.uv = tile_uv(tile, q.xy);
+    return hit;
+}
+
+// Hard visibility (0 shadowed, 1 lit): one bilinear comparison tap.
+fn hard_visibility(atlas: texture_depth_2d, map: mat4x4<f32>, tile: vec4<f32>, extent: vec4<f32>,
+                   atlas_size: vec2<f32>, p: vec3<f32>, n: vec3<f32>, cos_light: f32) -> f32 {
+    let hit = tile_hit(map, tile, extent, p, n, cos_light);
+    if !hit.inside {
         return 1.0;
     }
-    let depth = min(q.z, 1.0) - (1.0 + 2.0 * slope) * texel_world / extent.y;
-    let texel_uv = 1.0 / atlas_size;
-    let uv = tile_uv(tile, q.xy);
-    if !soft || tan_half <= 0.0 {
-        return textureSampleCompareLevel(atlas, shadow_sampler, clamp_to_tile(uv, tile, texel_uv), depth);
+    return textureSampleCompareLevel(atlas, shadow_sampler, clamp_to_tile(hit.uv, tile, 1.0 / atlas_size), hit.depth);
+}
+
+// Soft visibility by PCSS over a cone of half-angle tangent `tan_half`; `noise` in [0, 1)
+// rotates the taps per pixel.
+fn soft_visibility(atlas: texture_depth_2d, map: mat4x4<f32>, tile: vec4<f32>, extent: vec4<f32>,
+                   atlas_size: vec2<f32>, tan_half: f32, p: vec3<f32>, n: vec3<f32>,
+                   cos_light: f32, noise: f32) -> f32 {
+    let hit = tile_hit(map, tile, extent, p, n, cos_light);
+    if !hit.inside {
+        return 1.0;
     }
+    let texel_uv = 1.0 / atlas_size;
+    let texel_world = extent.z;
+    let depth = hit.depth;
+    let slope = hit.slope;
+    let uv = hit.uv;
     // World units to texture coordinates across this tile.
     let uv_per_world = tile.zw / (2.0 * extent.x);
     let receiver = depth * extent.y;
@@ -72,20 +92,21 @@ fn atlas_visibility(
     // to r tan(theta) deeper, which the blocker search and the filter must not count as a
     // blocker (without it the rotated taps print the noise pattern on surfaces turning away).
     let search_depth = depth - search * slope / extent.y;
+    let rotation = noise * 6.2831853;
+    let start = vec2<f32>(cos(rotation), sin(rotation));
+    // Vogel disk: tap k at radius sqrt((k + 0.5) / K), turned by the golden angle each step.
+    var dir = start;
     var blockers = 0.0;
     var blocker_sum = 0.0;
-    let rotation = noise * 6.2831853;
-    let c = cos(rotation);
-    let s = sin(rotation);
     for (var k = 0u; k < 12u; k = k + 1u) {
-        let o = POISSON[k];
-        let r = vec2<f32>(c * o.x - s * o.y, s * o.x + c * o.y);
-        let at = clamp_to_tile(uv + r * search * uv_per_world, tile, texel_uv);
+        let r = sqrt((f32(k) + 0.5) / 12.0);
+        let at = clamp_to_tile(uv + dir * (r * search) * uv_per_world, tile, texel_uv);
         let z = textureLoad(atlas, vec2<i32>(at * atlas_size), 0);
         if z < search_depth {
             blockers = blockers + 1.0;
             blocker_sum = blocker_sum + z;
         }
+        dir = vec2<f32>(dir.x * GOLDEN.x - dir.y * GOLDEN.y, dir.x * GOLDEN.y + dir.y * GOLDEN.x);
     }
     if blockers == 0.0 {
         return 1.0;
@@ -93,26 +114,52 @@ fn atlas_visibility(
     let blocker = blocker_sum / blockers * extent.y;
     let penumbra = clamp((receiver - blocker) * tan_half, texel_world, 0.5 * extent.x);
     let filter_depth = depth - penumbra * slope / extent.y;
+    dir = start;
     var lit = 0.0;
     for (var k = 0u; k < 16u; k = k + 1u) {
-        let o = POISSON[k];
-        let r = vec2<f32>(c * o.x - s * o.y, s * o.x + c * o.y);
-        let at = clamp_to_tile(uv + r * penumbra * uv_per_world, tile, texel_uv);
+        let r = sqrt((f32(k) + 0.5) / 16.0);
+        let at = clamp_to_tile(uv + dir * (r * penumbra) * uv_per_world, tile, texel_uv);
         lit = lit + textureSampleCompareLevel(atlas, shadow_sampler, at, filter_depth);
+        dir = vec2<f32>(dir.x * GOLDEN.x - dir.y * GOLDEN.y, dir.x * GOLDEN.y + dir.y * GOLDEN.x);
     }
     return lit / 16.0;
 }
 
+// The real geometry lies in one plane (frame.real_plane): a pipeline constant.
+override FLAT_REAL_LAYER: bool = false;
+
+// Visibility of light i in the real-geometry atlas.
 fn real_visibility(i: u32, p: vec3<f32>, n: vec3<f32>, noise: f32) -> f32 {
-    let light = lights[i];
-    return atlas_visibility(real_atlas, light.real_map, light.real_tile, light.real_extent,
-        frame.atlas.xy, light.direction.w, frame.counts.z == 1u, p, n,
-        dot(n, light.direction.xyz), noise);
+    if FLAT_REAL_LAYER {
+        // A ray leaving a point on the light's side of a plane (or on it) moves away from it:
+        // the flat real layer cannot block it, so no look-up (exact; on lavapipe the soft
+        // look-ups of the ground were half a frame). The margin is the atlas's own bias scale.
+        let plane = frame.real_plane;
+        let side = (dot(plane.xyz, p) + plane.w) * sign(dot(plane.xyz, lights[i].direction.xyz));
+        if side >= -2.0 * lights[i].real_extent.z {
+            return 1.0;
+        }
+        // Behind the plane: its shadow edge is the plane's border, far from what is seen;
+        // one hard tap.
+        return hard_visibility(real_atlas, lights[i].real_map, lights[i].real_tile,
+            lights[i].real_extent, frame.atlas.xy, p, n, dot(n, lights[i].direction.xyz));
+    }
+    let cos_light = dot(n, lights[i].direction.xyz);
+    if SOFT_SHADOWS && lights[i].direction.w > 0.0 {
+        return soft_visibility(real_atlas, lights[i].real_map, lights[i].real_tile,
+            lights[i].real_extent, frame.atlas.xy, lights[i].direction.w, p, n, cos_light, noise);
+    }
+    return hard_visibility(real_atlas, lights[i].real_map, lights[i].real_tile,
+        lights[i].real_extent, frame.atlas.xy, p, n, cos_light);
 }
 
+// Visibility of light i in the virtual-object atlas.
 fn virtual_visibility(i: u32, p: vec3<f32>, n: vec3<f32>, noise: f32) -> f32 {
-    let light = lights[i];
-    return atlas_visibility(virtual_atlas, light.virtual_map, light.virtual_tile,
-        light.virtual_extent, frame.atlas.zw, light.direction.w, frame.counts.z == 1u, p, n,
-        dot(n, light.direction.xyz), noise);
+    let cos_light = dot(n, lights[i].direction.xyz);
+    if SOFT_SHADOWS && lights[i].direction.w > 0.0 {
+        return soft_visibility(virtual_atlas, lights[i].virtual_map, lights[i].virtual_tile,
+            lights[i].virtual_extent, frame.atlas.zw, lights[i].direction.w, p, n, cos_light, noise);
+    }
+    return hard_visibility(virtual_atlas, lights[i].virtual_map, lights[i].virtual_tile,
+        lights[i].virtual_extent, frame.atlas.zw, p, n, cos_light);
 }
