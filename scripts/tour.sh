@@ -81,6 +81,19 @@ run capture-ball capture ball ball.exr side.exr --yaw 0,90 -o ball-merged.exr --
 run make-dual convert "$P/esplanade.exr" gear360.png --to dual-fisheye --fov 195 --width 1024
 run capture-fisheye capture fisheye gear360.png -o fisheye.exr --fov 195 --width 512
 
+# The reconstructed room, its manipulations, the outdoor sequence, a batch.
+R="$REPO/assets/rooms/apartment"
+run room-calibrate room calibrate "$R/marks.json" -o room.toml
+run room-estimate room estimate "$R/room.toml" -o apt
+run room-lights room lights "$R/room.toml" -n 32 -o apt-lights.json
+run room-render room render "$R/room.toml" --edit "$R/edits.toml" -o after.png --before before.png
+run room-render-view room render "$R/room.toml" --edit "$R/edits-view.toml" -o view.exr --json
+run outdoor outdoor "$REPO/assets/outdoor/courtyard/scene.toml" --out day
+mkdir -p batch-probes
+cp "$P/sky.exr" "$P/night.exr" batch-probes/
+printf '[input]\nfolder = "batch-probes"\n[output]\nfolder = "batch-out"\n[steps.lights]\nn = 16\n[steps.sh]\n[steps.preview]\n' >batch.toml
+run batch batch batch.toml --json
+
 # The demo on one probe and one scene.
 mkdir -p demo-probes demo-scenes
 cp "$P/sky.exr" demo-probes/

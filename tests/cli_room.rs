@@ -273,3 +273,73 @@ fn outputs_are_checked_before_any_work() {
     ]);
     assert_eq!(out.status.code(), Some(2));
 }
+
+#[test]
+fn room_render_writes_before_and_after_and_refuses_bad_edits_before_the_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let room = repo().join("assets/rooms/apartment/room.toml");
+    let edits = repo().join("assets/rooms/apartment/edits.toml");
+    let (after, before) = (dir.path().join("after.exr"), dir.path().join("before.png"));
+    let o = ibl(&[
+        "room",
+        "render",
+        &s(&room),
+        "--edit",
+        &s(&edits),
+        "-o",
+        &s(&after),
+        "--before",
+        &s(&before),
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let summary: Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(summary["kind"], "panorama");
+    assert_eq!(summary["materials"][0]["group"], "floor");
+    assert!(after.is_file() && before.is_file());
+
+    // An unknown group names the room's surface groups; exit 2.
+    let bad = dir.path().join("bad.toml");
+    std::fs::write(
+        &bad,
+        "version = 1\n[[material]]\ngroup = \"sofa\"\nreflectance = [0.5, 0.5, 0.5]\n",
+    )
+    .unwrap();
+    let out = dir.path().join("x.exr");
+    let o = ibl(&[
+        "room",
+        "render",
+        &s(&room),
+        "--edit",
+        &s(&bad),
+        "-o",
+        &s(&out),
+    ]);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(
+        e.contains("no surface group `sofa`") && e.contains("floor"),
+        "{e}"
+    );
+    assert!(!out.exists());
+    // A picture that cannot be written is refused before the estimate runs.
+    let o = ibl(&[
+        "room",
+        "render",
+        &s(&room),
+        "-o",
+        &s(&dir.path().join("x.txt")),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("x.txt"), "{}", stderr(&o));
+    let o = ibl(&[
+        "room",
+        "render",
+        &s(&room),
+        "-o",
+        &s(&out),
+        "--before",
+        &s(&out),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+}

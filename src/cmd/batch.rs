@@ -40,14 +40,11 @@ pub fn run(args: &BatchArgs) -> anyhow::Result<()> {
         true => println!("{:#}", serde_json::to_value(&summary)?),
         false => print!("{}", summary.text()),
     }
-    match summary.failed.len() {
+    // Exit 2, as `python -m iblkit.batch`, when a probe failed (its row says why).
+    let (n, items, rows) = (summary.failed.len(), summary.items, &summary.rows);
+    let message = format!("{n} of {items} probes failed; their rows are in {rows}");
+    match n {
         0 => Ok(()),
-        // Exit 2, as `python -m iblkit.batch`: a probe's input was at fault, or iblkit failed
-        // on it; its row says which (`error_kind`).
-        n => Err(ibl_pipeline::PipelineError::parameter(format!(
-            "{n} of {} probes failed; their rows are in {}",
-            summary.items, summary.rows
-        ))
-        .into()),
+        _ => Err(ibl_pipeline::PipelineError::parameter(message).into()),
     }
 }

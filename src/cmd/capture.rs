@@ -287,22 +287,9 @@ fn run_ball(args: &BallArgs) -> anyhow::Result<()> {
         width: args.width,
     };
     let s = unwrap_balls(&job)?;
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(&s)?);
-    } else {
-        for v in &s.views {
-            println!(
-                "{}: ball at ({:.1}, {:.1}) radius {:.1} px ({}), yaw {} deg, {:.0} % of the sphere reliable",
-                v.photo,
-                v.circle.cx,
-                v.circle.cy,
-                v.circle.r,
-                if v.found { "found" } else { "given" },
-                v.yaw_deg,
-                100.0 * v.reliable_fraction
-            );
-        }
-        println!("wrote {}", s.outputs.join(", "));
+    match args.json {
+        true => println!("{}", serde_json::to_string_pretty(&s)?),
+        false => print!("{}", s.text()),
     }
     Ok(())
 }

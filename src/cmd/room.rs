@@ -1,7 +1,8 @@
 //! `ibl room`: the reconstructed room of Grosch 2005 section 3 (`docs/ROOMS.md`): `calibrate`
 //! (marks to frame and scale), `estimate` (room and probe to reflectance and the report),
-//! `lights` (the important patches as an area-light file). The jobs are
-//! `ibl_pipeline::room_calibrate`, `room_estimate` and `room_lights`.
+//! `lights` (the important patches as an area-light file), `render` (the room after material
+//! changes or from a moved camera). The jobs are `ibl_pipeline::room_calibrate`,
+//! `room_estimate`, `room_lights` and `room_render`.
 
 use std::path::PathBuf;
 
@@ -9,6 +10,7 @@ use clap::{Args, Subcommand};
 use ibl_pipeline::room_calibrate::{CalibrateOptions, room_calibrate};
 use ibl_pipeline::room_estimate::{EstimateOptions, SamplingOptions, room_estimate};
 use ibl_pipeline::room_lights::{RoomLightsOptions, room_lights};
+use ibl_pipeline::room_render::{RoomRenderOptions, room_render};
 
 use crate::progress::Bars;
 
@@ -27,6 +29,36 @@ enum RoomCommand {
     Estimate(EstimateArgs),
     /// The room's N important light patches as an area-light file for `ibl render --lights`.
     Lights(LightsArgs),
+    /// The room re-rendered after material changes (with colour bleeding) or from a moved camera.
+    Render(RenderArgs),
+}
+
+/// Arguments of `ibl room render`.
+#[derive(Args)]
+#[command(after_help = "\
+The edits file (docs/ROOMS.md section 11): [[material]] changes with bounces of colour bleeding,
+and a [view] from a moved camera (else the edited probe is the output).
+
+Examples:
+  ibl room render assets/rooms/apartment/room.toml --edit assets/rooms/apartment/edits.toml -o a.png --before b.png
+  ibl room render room.toml --edit edits.toml -o view.exr --json")]
+struct RenderArgs {
+    /// Room file (.toml).
+    room: PathBuf,
+    /// Edits file (.toml); none: the room as estimated.
+    #[arg(long, value_name = "EDITS.toml")]
+    edit: Option<PathBuf>,
+    /// The picture after the edits (.exr, .hdr, .pfm, .png, .jpg).
+    #[arg(short = 'o', long, value_name = "FILE")]
+    output: PathBuf,
+    /// Also the picture before the edits.
+    #[arg(long, value_name = "FILE")]
+    before: Option<PathBuf>,
+    #[command(flatten)]
+    sampling: SamplingArgs,
+    /// Print the summary as JSON on stdout.
+    #[arg(long)]
+    json: bool,
 }
 
 /// Arguments of `ibl room calibrate`.
@@ -134,7 +166,24 @@ pub fn run(args: &RoomArgs) -> anyhow::Result<()> {
         RoomCommand::Calibrate(a) => calibrate(a),
         RoomCommand::Estimate(a) => estimate(a),
         RoomCommand::Lights(a) => lights(a),
+        RoomCommand::Render(a) => render(a),
     }
+}
+
+fn render(a: &RenderArgs) -> anyhow::Result<()> {
+    let options = RoomRenderOptions {
+        room: a.room.clone(),
+        edits: a.edit.clone(),
+        output: a.output.clone(),
+        before: a.before.clone(),
+        sampling: a.sampling.options(),
+    };
+    let result = room_render(&options, &Bars::default())?;
+    match a.json {
+        true => println!("{:#}", serde_json::to_value(&result)?),
+        false => print!("{}", result.text()),
+    }
+    Ok(())
 }
 
 fn calibrate(a: &CalibrateArgs) -> anyhow::Result<()> {
@@ -146,34 +195,9 @@ fn calibrate(a: &CalibrateArgs) -> anyhow::Result<()> {
         },
         &Bars::default(),
     )?;
-    if a.json {
-        println!("{}", serde_json::to_string_pretty(&result)?);
-        return Ok(());
-    }
-    let c = &result.calibration;
-    println!(
-        "{} lines: rotation [yaw, pitch, roll] {:.3?} deg, RMS residual {:.3} deg (largest {:.3})",
-        result.lines,
-        c.rotation_deg,
-        c.rms_residual_deg,
-        c.line_residuals_deg.iter().copied().fold(0.0, f64::max)
-    );
-    if let Some(s) = &result.scale {
-        println!(
-            "probe {:.3} m above the floor ({} scale marks, spread {:.2} %)",
-            s.probe_height_m,
-            s.marks.len(),
-            100.0 * s.spread
-        );
-    }
-    if let Some(p) = &result.proposal {
-        println!(
-            "automatic proposal: {:.3} deg from the marked frame ({} segments, residual {:.3} deg)",
-            p.angle_to_calibration_deg, p.proposal.segments, p.proposal.rms_residual_deg
-        );
-    }
-    if let Some(out) = &result.room_output {
-        println!("room file {out}: {} shapes", result.shapes);
+    match a.json {
+        true => println!("{}", serde_json::to_string_pretty(&result)?),
+        false => print!("{}", result.text()),
     }
     Ok(())
 }
@@ -212,26 +236,9 @@ fn lights(a: &LightsArgs) -> anyhow::Result<()> {
         },
         &Bars::default(),
     )?;
-    let f = &result.file;
-    if a.json {
-        let summary = serde_json::json!({
-            "room": a.room.display().to_string(),
-            "output": a.output.display().to_string(),
-            "patches": result.patches,
-            "lights": f.lights.len(),
-            "important_flux_fraction": f.important_flux_fraction,
-            "seconds": result.seconds,
-            "groups": f.lights.iter().map(|l| l.group.as_str()).collect::<Vec<_>>(),
-        });
-        println!("{summary:#}");
-    } else {
-        println!(
-            "{} of {} patches, {:.1} % of the room's luminous flux, in {}",
-            f.lights.len(),
-            result.patches,
-            100.0 * f.important_flux_fraction,
-            a.output.display()
-        );
+    match a.json {
+        true => println!("{:#}", result.summary_json(&a.room, &a.output)),
+        false => print!("{}", result.text(&a.output)),
     }
     Ok(())
 }

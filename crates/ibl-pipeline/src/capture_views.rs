@@ -62,6 +62,26 @@ pub struct BallSummary {
     pub outputs: Vec<String>,
 }
 
+impl BallSummary {
+    /// What `ibl capture ball` prints: each view's ball and reliable fraction, the files.
+    pub fn text(&self) -> String {
+        let mut text = String::new();
+        for v in &self.views {
+            text += &format!(
+                "{}: ball at ({:.1}, {:.1}) radius {:.1} px ({}), yaw {} deg, {:.0} % of the sphere reliable\n",
+                v.photo,
+                v.circle.cx,
+                v.circle.cy,
+                v.circle.r,
+                if v.found { "found" } else { "given" },
+                v.yaw_deg,
+                100.0 * v.reliable_fraction
+            );
+        }
+        text + &format!("wrote {}\n", self.outputs.join(", "))
+    }
+}
+
 /// The yaws of `n` views when none are given: 0, 90, 180, ... degrees.
 pub fn default_yaws(n: usize) -> Vec<f32> {
     (0..n).map(|k| 90.0 * k as f32).collect()

@@ -14,6 +14,8 @@ use crate::error::{Context, Result};
 use crate::progress::Progress;
 use crate::room_estimate::{SamplingOptions, estimate_room, report, write_pictures};
 use crate::room_lights::write_lights;
+use crate::room_render::{RoomEdits, render_edits};
+use ibl_core::tonemap::{Display, ToneCurve, auto_exposure_stops};
 
 /// Important patches the demo lists and exports.
 pub const DEMO_IMPORTANT_PATCHES: usize = 16;
@@ -49,8 +51,77 @@ pub struct RoomResult {
     /// Share of the room's luminous flux in the important patches.
     pub important_flux_fraction: f64,
     /// Paths relative to the demo folder: report.md, report.json, lights.json, rho-panorama.png,
-    /// overlay.png, cutaway.png.
+    /// overlay.png, cutaway.png, and each manipulation's pictures.
     pub files: Vec<String>,
+    /// Grosch 2005 section 4's manipulations of the room, before and after.
+    pub manipulations: Vec<RoomManipulation>,
+}
+
+/// One manipulation of the demo's room (an edits file beside the room file, `ibl room render`).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RoomManipulation {
+    /// The edits file.
+    pub edits: String,
+    /// What it does, for the page.
+    pub caption: String,
+    /// The picture before, relative to the demo folder.
+    pub before: String,
+    /// The picture after.
+    pub after: String,
+}
+
+/// The edits files the demo applies, beside the room file: file, picture prefix, caption.
+const DEMO_EDITS: [(&str, &str, &str); 2] = [
+    (
+        "edits.toml",
+        "material",
+        "the floor's reflectance changed (Grosch 2005 section 4.3): its radiance scaled by \
+         rho'/rho, one bounce of colour bleeding onto the rest of the room",
+    ),
+    (
+        "edits-view.toml",
+        "view",
+        "the same change seen from a camera moved 0.6 m (section 4.4): the probe projected on \
+         the model, the estimate rho E / pi where the probe did not see",
+    ),
+];
+
+/// Renders each of [`DEMO_EDITS`] found beside `room` into `dir` (before and after PNGs at one
+/// exposure).
+fn manipulations(
+    estimated: &crate::room_estimate::EstimatedRoom,
+    room: &Path,
+    dir: &Path,
+) -> Result<Vec<RoomManipulation>> {
+    let mut out = Vec::new();
+    for (file, prefix, caption) in DEMO_EDITS {
+        let path = room.with_file_name(file);
+        if !path.is_file() {
+            continue;
+        }
+        let edits = RoomEdits::read(&path)?;
+        let pictures = render_edits(estimated, &edits, room).context(path.display().to_string())?;
+        let options = ibl_io::WriteOptions {
+            display: Display {
+                exposure_stops: auto_exposure_stops(&pictures.before),
+                curve: ToneCurve::AcesFilmic,
+            },
+            ..Default::default()
+        };
+        let (before, after) = (
+            format!("{prefix}-before.png"),
+            format!("{prefix}-after.png"),
+        );
+        ibl_io::write_image(&dir.join(&before), &pictures.before, &options)?;
+        ibl_io::write_image(&dir.join(&after), &pictures.after, &options)?;
+        out.push(RoomManipulation {
+            edits: path.display().to_string(),
+            caption: caption.to_string(),
+            before: format!("{ROOM_DIR}/{before}"),
+            after: format!("{ROOM_DIR}/{after}"),
+        });
+    }
+    Ok(out)
 }
 
 /// Estimates the room file `room` into `out/room/`.
@@ -77,7 +148,22 @@ pub fn demo_room(room: &Path, out: &Path, progress: &dyn Progress) -> Result<Roo
         DEMO_IMPORTANT_PATCHES,
         progress,
     )?;
+    let manipulations = manipulations(&estimated, room, &dir)?;
     let estimate = &estimated.analysis.estimate;
+    let mut files: Vec<String> = [
+        "report.md",
+        "report.json",
+        "lights.json",
+        "rho-panorama.png",
+        "overlay.png",
+        "cutaway.png",
+    ]
+    .iter()
+    .map(|f| format!("{ROOM_DIR}/{f}"))
+    .collect();
+    for m in &manipulations {
+        files.extend([m.before.clone(), m.after.clone()]);
+    }
     Ok(RoomResult {
         room: name,
         patches: estimated.input.room.patches.len(),
@@ -95,17 +181,8 @@ pub fn demo_room(room: &Path, out: &Path, progress: &dyn Progress) -> Result<Roo
             })
             .collect(),
         important_flux_fraction: lights.important_flux_fraction,
-        files: [
-            "report.md",
-            "report.json",
-            "lights.json",
-            "rho-panorama.png",
-            "overlay.png",
-            "cutaway.png",
-        ]
-        .iter()
-        .map(|f| format!("{ROOM_DIR}/{f}"))
-        .collect(),
+        files,
+        manipulations,
     })
 }
 
@@ -165,6 +242,21 @@ pub fn room_html(r: &RoomResult) -> String {
         let _ = write!(
             html,
             "<figure><img class=wide src=\"{ROOM_DIR}/{file}\"><figcaption>{caption}</figcaption></figure>"
+        );
+    }
+    if !r.manipulations.is_empty() {
+        html.push_str(
+            "<h2>Manipulations</h2><p>Each an edits file beside the room file, rendered by \
+             <code>ibl room render ROOM --edit EDITS -o after.png --before before.png</code>; \
+             before and after at the same exposure.</p>",
+        );
+    }
+    for m in &r.manipulations {
+        let _ = write!(
+            html,
+            "<figure><img src=\"{}\"> <img src=\"{}\"><figcaption>before, after: {} \
+             (<code>{}</code>)</figcaption></figure>",
+            m.before, m.after, m.caption, m.edits
         );
     }
     html

@@ -15,9 +15,10 @@
 //!   [`render`]: a scene rendered and composited;
 //! - [`eval`]: the comparison of the extraction methods as a report folder; [`compare`]: image
 //!   metrics between two files;
-//! - [`room_calibrate`], [`room_estimate`], [`room_lights`]: the reconstructed room of Grosch
-//!   2005 (marks to frame and scale, room and probe to reflectance and the report, the important
-//!   patches as an area-light file), on [`room_input`];
+//! - [`room_calibrate`], [`room_estimate`], [`room_lights`], [`room_render`]: the reconstructed
+//!   room of Grosch 2005 (marks to frame and scale, room and probe to reflectance and the
+//!   report, the important patches as an area-light file, the room re-rendered after material
+//!   changes and from a moved camera), on [`room_input`];
 //! - [`outdoor`]: outdoor AR under changing light (Jensen, Andersen & Madsen 2006): per-frame
 //!   sun and sky estimates, relit maps and composites of a frame sequence; [`video`]: video in
 //!   and out through ffmpeg;
@@ -69,6 +70,7 @@ pub mod room_calibrate;
 pub mod room_estimate;
 pub mod room_input;
 pub mod room_lights;
+pub mod room_render;
 pub mod sh;
 pub mod video;
 

@@ -59,6 +59,39 @@ pub struct CalibrateResult {
     pub shapes: usize,
 }
 
+impl CalibrateResult {
+    /// What `ibl room calibrate` prints: the frame and its residuals, the scale, the proposal
+    /// and the room file written.
+    pub fn text(&self) -> String {
+        let c = &self.calibration;
+        let mut text = format!(
+            "{} lines: rotation [yaw, pitch, roll] {:.3?} deg, RMS residual {:.3} deg (largest {:.3})\n",
+            self.lines,
+            c.rotation_deg,
+            c.rms_residual_deg,
+            c.line_residuals_deg.iter().copied().fold(0.0, f64::max)
+        );
+        if let Some(s) = &self.scale {
+            text += &format!(
+                "probe {:.3} m above the floor ({} scale marks, spread {:.2} %)\n",
+                s.probe_height_m,
+                s.marks.len(),
+                100.0 * s.spread
+            );
+        }
+        if let Some(p) = &self.proposal {
+            text += &format!(
+                "automatic proposal: {:.3} deg from the marked frame ({} segments, residual {:.3} deg)\n",
+                p.angle_to_calibration_deg, p.proposal.segments, p.proposal.rms_residual_deg
+            );
+        }
+        if let Some(out) = &self.room_output {
+            text += &format!("room file {out}: {} shapes\n", self.shapes);
+        }
+        text
+    }
+}
+
 /// The angle of the rotation `a^T b`, degrees (accurate for small angles too: atan2 of the
 /// skew part's length and the trace).
 pub fn rotation_angle_deg(a: DMat3, b: DMat3) -> f64 {

@@ -43,6 +43,32 @@ pub struct RoomLightsResult {
     pub seconds: f64,
 }
 
+impl RoomLightsResult {
+    /// The summary `ibl room lights --json` prints.
+    pub fn summary_json(&self, room: &Path, output: &Path) -> serde_json::Value {
+        serde_json::json!({
+            "room": room.display().to_string(),
+            "output": output.display().to_string(),
+            "patches": self.patches,
+            "lights": self.file.lights.len(),
+            "important_flux_fraction": self.file.important_flux_fraction,
+            "seconds": self.seconds,
+            "groups": self.file.lights.iter().map(|l| l.group.as_str()).collect::<Vec<_>>(),
+        })
+    }
+
+    /// What `ibl room lights` prints.
+    pub fn text(&self, output: &Path) -> String {
+        format!(
+            "{} of {} patches, {:.1} % of the room's luminous flux, in {}\n",
+            self.file.lights.len(),
+            self.patches,
+            100.0 * self.file.important_flux_fraction,
+            output.display()
+        )
+    }
+}
+
 fn check(o: &RoomLightsOptions) -> Result<()> {
     if o.count == 0 || o.count > MAX_IMPORTANT_PATCHES {
         return Err(PipelineError::parameter(format!(

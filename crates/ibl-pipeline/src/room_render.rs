@@ -1,0 +1,554 @@
+//! `ibl room render`: the reconstructed room re-rendered after Grosch 2005 section 4's
+//! manipulations, read from an edits file: material changes (section 4.3: the changed groups'
+//! radiance scaled by `rho' / rho` at once, then colour bleeding by delta radiosity over the
+//! room's form factors, `bounces` bounces) and a moved camera (section 4.4: the probe projected on
+//! the geometry where it saw, `B / pi` where it did not, optionally modulated by the seen texture
+//! of the same face). Without a `[view]`, the output is the edited probe (lat-long); with one,
+//! the view from the moved camera. `--before` writes the same picture without the edits, at the
+//! same exposure, for side-by-side comparison.
+//!
+//! ```toml
+//! version = 1
+//! bounces = 1                        # colour bleeding (0: the direct change only)
+//!
+//! [[material]]                       # any number; each group at most once
+//! group = "floor"                    # a surface group of the room file
+//! reflectance = [0.60, 0.25, 0.20]   # linear RGB in [0, 1]
+//!
+//! [view]                             # optional: a camera moved inside the room
+//! position = [0.5, 1.2, 0.0]         # metres, world frame (docs/CONVENTIONS.md)
+//! look_at = [0.0, 1.0, -2.0]
+//! vertical_fov_deg = 60.0
+//! size = [640, 480]
+//! fill = "textured"                  # or "estimate" (Grosch's rho E / pi)
+//! samples_per_axis = 2
+//! ```
+//!
+//! Paths in the edits file: none. Unknown keys are refused with their name and line.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use glam::{Vec2, Vec3};
+use ibl_core::tonemap::{Display, ToneCurve, auto_exposure_stops};
+use ibl_core::{Image, Rgb};
+use ibl_io::WriteOptions;
+use ibl_room::room_radiance::RoomRadiance;
+use ibl_room::{
+    FillTexture, FillTextureSettings, GroupKind, HoleFill, MaterialChange, NovelViewSettings,
+    change_materials, render_novel_view,
+};
+use ibl_scene::Camera;
+use serde::{Deserialize, Serialize};
+
+use crate::error::{PipelineError, Result};
+use crate::progress::Progress;
+use crate::room_estimate::{EstimatedRoom, SamplingOptions, estimate_room};
+
+/// Largest edits file read, bytes.
+const MAX_EDITS_BYTES: u64 = 1 << 20;
+
+/// The edits file as written.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct EditsFile {
+    version: u32,
+    #[serde(default = "one")]
+    bounces: u32,
+    #[serde(default)]
+    material: Vec<MaterialEntry>,
+    view: Option<ViewEntry>,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MaterialEntry {
+    group: String,
+    reflectance: [f32; 3],
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ViewEntry {
+    position: [f32; 3],
+    look_at: [f32; 3],
+    #[serde(default = "default_fov")]
+    vertical_fov_deg: f32,
+    #[serde(default = "default_size")]
+    size: [u32; 2],
+    #[serde(default = "default_fill")]
+    fill: String,
+    #[serde(default = "default_samples")]
+    samples_per_axis: u32,
+}
+
+fn one() -> u32 {
+    1
+}
+fn default_fov() -> f32 {
+    60.0
+}
+fn default_size() -> [u32; 2] {
+    [640, 480]
+}
+fn default_fill() -> String {
+    "textured".into()
+}
+fn default_samples() -> u32 {
+    NovelViewSettings::default().samples_per_axis
+}
+
+/// A camera moved inside the room.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ViewEdit {
+    /// Eye, metres, world frame.
+    pub position: Vec3,
+    /// Point looked at.
+    pub look_at: Vec3,
+    /// Vertical field of view, degrees.
+    pub vertical_fov_deg: f32,
+    /// Output size, pixels.
+    pub width: u32,
+    /// Output size, pixels.
+    pub height: u32,
+    /// Whether the unseen surfaces' fill is modulated by the seen texture of their face.
+    pub textured: bool,
+    /// Rays per pixel along each axis.
+    pub samples_per_axis: u32,
+}
+
+/// A checked edits file.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RoomEdits {
+    /// Bounces of colour bleeding.
+    pub bounces: u32,
+    /// Surface group name and its new reflectance, in file order.
+    pub materials: Vec<(String, Rgb)>,
+    /// The moved camera, if any.
+    pub view: Option<ViewEdit>,
+}
+
+impl RoomEdits {
+    /// No edits: the room as estimated, its probe as the picture.
+    pub fn none() -> RoomEdits {
+        RoomEdits {
+            bounces: 1,
+            materials: Vec::new(),
+            view: None,
+        }
+    }
+
+    /// Reads and checks `path`.
+    pub fn read(path: &Path) -> Result<RoomEdits> {
+        let text = ibl_io::read_text(path, MAX_EDITS_BYTES)?;
+        RoomEdits::parse(&text, path)
+    }
+
+    /// Parses `text` as the edits file `path` (for messages).
+    pub fn parse(text: &str, path: &Path) -> Result<RoomEdits> {
+        let shown = path.display();
+        let bad = |m: String| PipelineError::parameter(format!("{shown}: {m}"));
+        let file: EditsFile = toml::from_str(text).map_err(|e| bad(e.to_string()))?;
+        if file.version != 1 {
+            return Err(bad(format!(
+                "version {} (this iblkit reads version 1)",
+                file.version
+            )));
+        }
+        if file.bounces > ibl_room::material_change::MAX_BOUNCES {
+            return Err(bad(format!(
+                "bounces = {} (at most {})",
+                file.bounces,
+                ibl_room::material_change::MAX_BOUNCES
+            )));
+        }
+        let mut materials = Vec::with_capacity(file.material.len());
+        for (k, m) in file.material.iter().enumerate() {
+            if !m.reflectance.iter().all(|v| (0.0..=1.0).contains(v)) {
+                return Err(bad(format!(
+                    "material[{k}] (group `{}`): reflectance {:?} is not in [0, 1]",
+                    m.group, m.reflectance
+                )));
+            }
+            if materials.iter().any(|(g, _): &(String, Rgb)| g == &m.group) {
+                return Err(bad(format!(
+                    "material[{k}]: group `{}` is changed twice",
+                    m.group
+                )));
+            }
+            materials.push((m.group.clone(), Rgb::from_array(m.reflectance)));
+        }
+        let view = match &file.view {
+            None => None,
+            Some(v) => Some(check_view(v).map_err(|m| bad(format!("[view] {m}")))?),
+        };
+        Ok(RoomEdits {
+            bounces: file.bounces,
+            materials,
+            view,
+        })
+    }
+}
+
+fn check_view(v: &ViewEntry) -> std::result::Result<ViewEdit, String> {
+    let finite = |a: &[f32; 3]| a.iter().all(|x| x.is_finite());
+    if !finite(&v.position) || !finite(&v.look_at) {
+        return Err("position and look_at must be finite".into());
+    }
+    let (position, look_at) = (Vec3::from(v.position), Vec3::from(v.look_at));
+    let forward = look_at - position;
+    if forward.length() < 1e-6 || forward.normalize().cross(Vec3::Y).length() < 1e-6 {
+        return Err("look_at must differ from position and not be straight up or down".into());
+    }
+    if !(v.vertical_fov_deg > 0.0 && v.vertical_fov_deg < 179.0) {
+        return Err(format!(
+            "vertical_fov_deg {} is not in (0, 179)",
+            v.vertical_fov_deg
+        ));
+    }
+    let [width, height] = v.size;
+    if width == 0 || height == 0 || u64::from(width) * u64::from(height) > 64 << 20 {
+        return Err(format!(
+            "size {width} x {height} is empty or more than 64 Mpixels"
+        ));
+    }
+    let textured = match v.fill.as_str() {
+        "textured" => true,
+        "estimate" => false,
+        other => return Err(format!("fill `{other}` (textured or estimate)")),
+    };
+    if !(1..=ibl_room::novel_view::MAX_SAMPLES_PER_AXIS).contains(&v.samples_per_axis) {
+        return Err(format!(
+            "samples_per_axis {} (1 to {})",
+            v.samples_per_axis,
+            ibl_room::novel_view::MAX_SAMPLES_PER_AXIS
+        ));
+    }
+    Ok(ViewEdit {
+        position,
+        look_at,
+        vertical_fov_deg: v.vertical_fov_deg,
+        width,
+        height,
+        textured,
+        samples_per_axis: v.samples_per_axis,
+    })
+}
+
+/// What `ibl room render` is asked to do.
+#[derive(Clone, Debug)]
+pub struct RoomRenderOptions {
+    /// The room file.
+    pub room: PathBuf,
+    /// The edits file (none: the room as estimated).
+    pub edits: Option<PathBuf>,
+    /// The picture after the edits (`.exr`, `.hdr`, `.pfm`, `.png`, `.jpg`).
+    pub output: PathBuf,
+    /// The same picture before the edits, at the same exposure.
+    pub before: Option<PathBuf>,
+    /// The estimate's form-factor sampling.
+    pub sampling: SamplingOptions,
+}
+
+/// What `ibl room render` did (its `--json`).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RoomRenderResult {
+    /// The room file.
+    pub room: String,
+    /// `panorama` (the edited probe) or `view` (a moved camera).
+    pub kind: &'static str,
+    /// Output size, pixels.
+    pub width: usize,
+    /// Output size, pixels.
+    pub height: usize,
+    /// The groups changed, with their reflectance before and after.
+    pub materials: Vec<MaterialRow>,
+    /// Bounces of colour bleeding made.
+    pub bounces: u32,
+    /// The last bounce's largest change relative to the largest radiosity (what another bounce
+    /// would add, roughly).
+    pub last_bounce_relative: f32,
+    /// A view's pixels whose rays all met surfaces the probe did not see (filled), fraction.
+    pub filled_fraction: Option<f64>,
+    /// Exposure of `.png`/`.jpg` outputs, stops (the before picture's automatic exposure).
+    pub exposure_stops: f32,
+    /// Seconds: the estimate (depth map, form factors, radiosity), the edit, the picture(s).
+    pub seconds_estimate: f64,
+    /// Seconds of the material edit (direct change and bleeding).
+    pub seconds_edit: f64,
+    /// Seconds of rendering the picture(s).
+    pub seconds_render: f64,
+    /// Files written.
+    pub outputs: Vec<String>,
+}
+
+impl RoomRenderResult {
+    /// What `ibl room render` prints.
+    pub fn text(&self) -> String {
+        let mut text = format!("{} x {} {}", self.width, self.height, self.kind);
+        for m in &self.materials {
+            text += &format!(
+                "; {}: reflectance {:.3?} -> {:.3?}",
+                m.group, m.before, m.after
+            );
+        }
+        if !self.materials.is_empty() {
+            text += &format!(
+                "; {} bounces of colour bleeding (the last changed {:.2} %)",
+                self.bounces,
+                100.0 * self.last_bounce_relative
+            );
+        }
+        if let Some(f) = self.filled_fraction {
+            text += &format!(
+                "; {:.1} % of the pixels filled (unseen by the probe)",
+                100.0 * f
+            );
+        }
+        text += &format!(
+            "\nestimate {:.2} s, edit {:.3} s, picture {:.2} s; wrote {}\n",
+            self.seconds_estimate,
+            self.seconds_edit,
+            self.seconds_render,
+            self.outputs.join(", ")
+        );
+        text
+    }
+}
+
+/// One changed group.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct MaterialRow {
+    /// Group name.
+    pub group: String,
+    /// The estimate's reflectance.
+    pub before: [f32; 3],
+    /// The edit's.
+    pub after: [f32; 3],
+}
+
+/// Runs `ibl room render`.
+pub fn room_render(o: &RoomRenderOptions, progress: &dyn Progress) -> Result<RoomRenderResult> {
+    let edits = match &o.edits {
+        Some(p) => RoomEdits::read(p)?,
+        None => RoomEdits::none(),
+    };
+    let mut inputs: Vec<&Path> = vec![&o.room];
+    inputs.extend(o.edits.as_deref());
+    let outputs: Vec<&Path> = std::iter::once(o.output.as_path())
+        .chain(o.before.as_deref())
+        .collect();
+    for out in &outputs {
+        if ibl_io::ImageFormat::from_path(out).is_none() {
+            return Err(PipelineError::parameter(format!(
+                "{}: write the picture as .exr, .hdr, .pfm, .png or .jpg",
+                out.display()
+            )));
+        }
+        crate::output_paths::check_output_path(out, &inputs)?;
+    }
+    if o.before.as_deref() == Some(o.output.as_path()) {
+        return Err(PipelineError::parameter(format!(
+            "{}: --before and -o name the same file",
+            o.output.display()
+        )));
+    }
+    let start = Instant::now();
+    let estimated = estimate_room(&o.room, &o.sampling, progress)?;
+    for out in &outputs {
+        crate::output_paths::check_output_path(out, &[&estimated.input.probe_path])?;
+    }
+    let seconds_estimate = start.elapsed().as_secs_f64();
+    let pictures = render_edits(&estimated, &edits, &o.room)?;
+    let (before, after) = (&pictures.before, &pictures.after);
+    let stops = auto_exposure_stops(before);
+    let options = WriteOptions {
+        display: Display {
+            exposure_stops: stops,
+            curve: ToneCurve::AcesFilmic,
+        },
+        ..Default::default()
+    };
+    ibl_io::write_image(&o.output, after, &options)?;
+    let mut written = vec![o.output.display().to_string()];
+    if let Some(path) = &o.before {
+        ibl_io::write_image(path, before, &options)?;
+        written.push(path.display().to_string());
+    }
+    Ok(RoomRenderResult {
+        room: o.room.display().to_string(),
+        kind: if edits.view.is_some() {
+            "view"
+        } else {
+            "panorama"
+        },
+        width: after.width(),
+        height: after.height(),
+        materials: pictures.materials.clone(),
+        bounces: pictures.bounces,
+        last_bounce_relative: pictures.last_bounce_relative,
+        filled_fraction: pictures.filled_fraction,
+        exposure_stops: stops,
+        seconds_estimate,
+        seconds_edit: pictures.seconds_edit,
+        seconds_render: pictures.seconds_render,
+        outputs: written,
+    })
+}
+
+/// The pictures of an estimated room before and after `edits`: the probe and the edited probe,
+/// or the view from the moved camera without and with the edits (radiance, probe units).
+#[derive(Clone, Debug)]
+pub struct EditedPictures {
+    /// Without the edits.
+    pub before: Image<Rgb>,
+    /// With them.
+    pub after: Image<Rgb>,
+    /// The groups changed.
+    pub materials: Vec<MaterialRow>,
+    /// Bounces of colour bleeding made.
+    pub bounces: u32,
+    /// The last bounce's relative change.
+    pub last_bounce_relative: f32,
+    /// A view's fraction of filled pixels.
+    pub filled_fraction: Option<f64>,
+    /// Seconds of the edit.
+    pub seconds_edit: f64,
+    /// Seconds of the pictures.
+    pub seconds_render: f64,
+}
+
+/// Applies `edits` to `estimated` (the room file `room_path`, for messages) and renders the
+/// pictures before and after.
+pub fn render_edits(
+    estimated: &EstimatedRoom,
+    edits: &RoomEdits,
+    room_path: &Path,
+) -> Result<EditedPictures> {
+    let (changes, rows) = resolve_materials(estimated, edits, room_path)?;
+
+    let start = Instant::now();
+    let room = &estimated.input.room;
+    let analysis = &estimated.analysis;
+    let edit = change_materials(
+        room,
+        &analysis.estimate,
+        &analysis.form_factors,
+        &changes,
+        edits.bounces,
+    )?;
+    let after_probe = edit.panorama(&analysis.depth, &estimated.probe)?;
+    let seconds_edit = start.elapsed().as_secs_f64();
+
+    let start = Instant::now();
+    let (before, after, filled_fraction) = match &edits.view {
+        None => (estimated.probe.clone(), after_probe, None),
+        Some(view) => {
+            let mut edited_estimate = analysis.estimate.clone();
+            for (patch, b) in edited_estimate.patches.iter_mut().zip(&edit.radiosity) {
+                patch.radiosity = *b;
+            }
+            let texture = if view.textured {
+                Some(FillTexture::new(
+                    room,
+                    &analysis.depth,
+                    &estimated.probe,
+                    &analysis.estimate,
+                    &FillTextureSettings::default(),
+                )?)
+            } else {
+                None
+            };
+            let fill = texture
+                .as_ref()
+                .map_or(HoleFill::Estimate, HoleFill::Textured);
+            let camera = view_camera(view);
+            let settings = NovelViewSettings {
+                samples_per_axis: view.samples_per_axis,
+            };
+            let render = |probe: &Image<Rgb>, estimate| -> Result<ibl_room::NovelView> {
+                let field = RoomRadiance::new(room, &analysis.depth, probe, estimate)?;
+                Ok(render_novel_view(
+                    &field,
+                    &camera,
+                    view.width,
+                    view.height,
+                    fill,
+                    &settings,
+                )?)
+            };
+            let before = render(&estimated.probe, &analysis.estimate)?;
+            let after = render(&after_probe, &edited_estimate)?;
+            let filled = after.filled_mask();
+            let n = filled.pixels().iter().filter(|&&f| f).count();
+            let fraction = n as f64 / filled.pixels().len().max(1) as f64;
+            (before.image, after.image, Some(fraction))
+        }
+    };
+    Ok(EditedPictures {
+        before,
+        after,
+        materials: rows,
+        bounces: edit.bounces,
+        last_bounce_relative: edit.last_bounce_relative,
+        filled_fraction,
+        seconds_edit,
+        seconds_render: start.elapsed().as_secs_f64(),
+    })
+}
+
+/// The edits' group names as the room's surface groups, with the estimate's reflectances.
+fn resolve_materials(
+    estimated: &EstimatedRoom,
+    edits: &RoomEdits,
+    room_path: &Path,
+) -> Result<(Vec<MaterialChange>, Vec<MaterialRow>)> {
+    let room = &estimated.input.room;
+    let surfaces: Vec<&str> = room
+        .groups
+        .iter()
+        .filter(|g| g.kind == GroupKind::Surface)
+        .map(|g| g.name.as_str())
+        .collect();
+    let mut changes = Vec::new();
+    let mut rows = Vec::new();
+    for (name, reflectance) in &edits.materials {
+        let index = room
+            .groups
+            .iter()
+            .position(|g| &g.name == name && g.kind == GroupKind::Surface)
+            .ok_or_else(|| {
+                PipelineError::parameter(format!(
+                    "{}: no surface group `{name}` (the surface groups are: {})",
+                    room_path.display(),
+                    surfaces.join(", ")
+                ))
+            })?;
+        let before = estimated.analysis.estimate.groups[index]
+            .reflectance
+            .unwrap_or([0.0; 3]);
+        changes.push(MaterialChange {
+            group: index,
+            reflectance: *reflectance,
+        });
+        rows.push(MaterialRow {
+            group: name.clone(),
+            before,
+            after: reflectance.to_array(),
+        });
+    }
+    Ok((changes, rows))
+}
+
+/// The pinhole camera of a view (+Y up hint; square pixels).
+fn view_camera(v: &ViewEdit) -> Camera {
+    let focal = Camera::focal_from_vertical_fov(v.vertical_fov_deg, v.height);
+    Camera::look_at(
+        v.position,
+        v.look_at,
+        Vec3::Y,
+        Vec2::splat(focal),
+        Vec2::new(v.width as f32, v.height as f32) * 0.5,
+        (v.width, v.height),
+    )
+}

@@ -1,0 +1,24 @@
+//! Fuzz target: a room edits file's text (`ibl-pipeline::room_render`, read by
+//! `ibl room render --edit`) must parse to checked edits or an error naming the file, for any
+//! bytes, never panic; parsed edits hold only reflectances in [0, 1] and a bounded view.
+#![no_main]
+
+use std::path::Path;
+
+use libfuzzer_sys::fuzz_target;
+
+fuzz_target!(|data: &[u8]| {
+    let Ok(text) = std::str::from_utf8(data) else { return };
+    let path = Path::new("fuzz/edits.toml");
+    match ibl_pipeline::room_render::RoomEdits::parse(text, path) {
+        Ok(edits) => {
+            for (_, rho) in &edits.materials {
+                assert!(rho.to_array().iter().all(|v| (0.0..=1.0).contains(v)));
+            }
+            if let Some(v) = &edits.view {
+                assert!(v.width > 0 && v.height > 0 && u64::from(v.width) * u64::from(v.height) <= 64 << 20);
+            }
+        }
+        Err(e) => assert!(e.to_string().contains("edits.toml"), "{e}"),
+    }
+});
