@@ -186,7 +186,7 @@ mod tests {
         let (n, offset) = geometry(&[a, b, c, a, c, d]).real_plane().unwrap();
         assert!((n.y.abs() - 1.0).abs() < 1e-6 && n.x.abs() < 1e-6 && n.z.abs() < 1e-6);
         // n . p + d = 0 at y = -1.
-        assert!((n.y * -1.0 + offset).abs() < 1e-5);
+        assert!((offset - n.y).abs() < 1e-5);
         // One corner lifted by 1 mm over a 57 m diagonal is more than 1e-5 of the extent.
         let lifted = [20.0, -0.999, 20.0];
         assert!(
