@@ -118,6 +118,23 @@ impl BatchSummary {
 
 /// Lists the spec's probes and marks the done ones. Checks the output folder first.
 pub fn plan(spec: &BatchSpec, retry_failed: bool) -> Result<BatchPlan> {
+    let mut plan = listing(spec)?;
+    for item in &mut plan.items {
+        item.done = match read_row(&spec.out.join(&item.id).join("row.json")) {
+            Some(row) => {
+                row["probe"] == item.probe.display().to_string()
+                    && row["steps_sha256"] == plan.steps_sha256
+                    && (row["status"] == "ok" || !retry_failed)
+            }
+            None => false,
+        };
+    }
+    Ok(plan)
+}
+
+/// The spec's probes and their ids without reading any row (every `done` false): what
+/// [`finish`] needs once the items have run. Checks the output folder first.
+pub fn listing(spec: &BatchSpec) -> Result<BatchPlan> {
     crate::output_paths::check_output_folder(&spec.out)?;
     let probes = list_probes(spec)?;
     if probes.is_empty() {
@@ -137,26 +154,19 @@ pub fn plan(spec: &BatchSpec, retry_failed: bool) -> Result<BatchPlan> {
             )));
         }
     }
-    let steps_sha256 = spec.steps_sha256();
     let ids = item_ids(&probes);
     let items = probes
         .into_iter()
         .zip(ids)
-        .map(|(probe, id)| {
-            let done = match read_row(&spec.out.join(&id).join("row.json")) {
-                Some(row) => {
-                    row["probe"] == probe.display().to_string()
-                        && row["steps_sha256"] == steps_sha256
-                        && (row["status"] == "ok" || !retry_failed)
-                }
-                None => false,
-            };
-            BatchItem { id, probe, done }
+        .map(|(probe, id)| BatchItem {
+            id,
+            probe,
+            done: false,
         })
         .collect();
     Ok(BatchPlan {
         items,
-        steps_sha256,
+        steps_sha256: spec.steps_sha256(),
     })
 }
 
