@@ -28,10 +28,9 @@ pub struct FrameUniform {
     pub probe_position: [f32; 4],
     /// width, height, 1 / width, 1 / height.
     pub viewport: [f32; 4],
-    /// lights, composite rule, shadows, background kind.
+    /// x: the light count; y, z, w: 0 (the scene's other choices are pipeline constants,
+    /// `scene_pass.rs`'s `ShaderVariant`).
     pub counts: [u32; 4],
-    /// glossy source, ambient present, background rays per axis, frame number.
-    pub options: [u32; 4],
     /// glossy level-1 exponent, glossy levels, photo scale, ambient scale.
     pub environment: [f32; 4],
     /// real atlas size, virtual atlas size (texels).
@@ -274,7 +273,7 @@ mod tests {
     #[test]
     fn structs_match_their_wgsl_sizes() {
         // Sums of the WGSL members (all 16-byte columns): no padding on either side.
-        assert_eq!(std::mem::size_of::<FrameUniform>(), 3 * 64 + 9 * 16);
+        assert_eq!(std::mem::size_of::<FrameUniform>(), 3 * 64 + 8 * 16);
         assert_eq!(std::mem::size_of::<GpuLight>(), 2 * 64 + 6 * 16);
         assert_eq!(std::mem::size_of::<GpuObject>(), 2 * 64 + 16);
         assert_eq!(std::mem::size_of::<GpuMaterial>(), 32);

@@ -16,13 +16,10 @@ struct Frame {
     probe_position: vec4<f32>,
     // width, height, 1 / width, 1 / height.
     viewport: vec4<f32>,
-    // light count, composite rule (0 difference, 1 ratio), shadows (0 hard, 1 soft),
-    // background (0 panorama, 1 photo). The scene pass reads only the count: it takes the
-    // others (and options.x to z) as pipeline constants (scene_pass.rs, ShaderVariant).
+    // x: the light count; y, z, w: 0. The scene's other choices (composite rule, shadows,
+    // background, glossy source, ambient, background rays) are pipeline constants
+    // (scene_pass.rs, ShaderVariant).
     counts: vec4<u32>,
-    // glossy source (0 the lights, 1 the prefiltered probe), ambient (0 none, 1 the SH map),
-    // background rays per pixel axis, frame number.
-    options: vec4<u32>,
     // glossy chain: exponent of level 1, levels; photo scale; ambient scale.
     environment: vec4<f32>,
     // real atlas width, height; virtual atlas width, height (texels).

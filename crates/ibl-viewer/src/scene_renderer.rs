@@ -81,7 +81,9 @@ pub struct SceneRenderer {
     /// Whether the lights changed since the atlases were drawn.
     lights_changed: bool,
     timer: Option<PassTimer>,
-    frame_number: u32,
+    /// The real geometry's plane when it is flat (`SceneGeometry::real_plane`; real geometry
+    /// never changes after load, so it is found once).
+    real_plane: Option<(Vec3, f32)>,
     /// Pass times of the latest frame whose timestamps were read.
     pub last_pass_times: Option<PassTimes>,
 }
@@ -150,7 +152,7 @@ impl SceneRenderer {
             drawn_placements: None,
             lights_changed: true,
             timer: PassTimer::new(gpu, &SCENE_PASSES),
-            frame_number: 0,
+            real_plane: model.geometry.real_plane(),
             last_pass_times: None,
         })
     }
@@ -232,7 +234,6 @@ impl SceneRenderer {
         let c = &settings.camera;
         let (w, h) = self.targets.size;
         let probe = &model.scene.probe;
-        let description = &model.description;
         let atlas = |a: &crate::shadow_atlas::Atlas| a.size();
         let (rw, rh) = atlas(&self.shadows.real);
         let (vw, vh) = atlas(&self.shadows.virtual_objects);
@@ -249,30 +250,7 @@ impl SceneRenderer {
             probe_from_world: mat3_columns(probe.world_from_probe.transpose()),
             probe_position: vec4(probe.position, self.environment.scale),
             viewport: [w as f32, h as f32, 1.0 / w as f32, 1.0 / h as f32],
-            counts: [
-                lights,
-                match description.render.composite {
-                    CompositeRule::Difference => 0,
-                    CompositeRule::Ratio => 1,
-                },
-                match description.lighting.shadows {
-                    ibl_scene::ShadowKind::Hard => 0,
-                    ibl_scene::ShadowKind::Soft => 1,
-                },
-                match model.scene.background {
-                    Background::Panorama => 0,
-                    Background::Photo(_) => 1,
-                },
-            ],
-            options: [
-                match settings.glossy {
-                    GlossySource::Lights => 0,
-                    GlossySource::Environment => 1,
-                },
-                u32::from(self.lighting.as_ref().is_some_and(|l| l.ambient.is_some())),
-                settings.background_rays.clamp(1, 8),
-                self.frame_number,
-            ],
+            counts: [lights, 0, 0, 0],
             environment: [
                 self.environment.first_exponent,
                 self.environment.levels as f32,
@@ -280,9 +258,8 @@ impl SceneRenderer {
                 self.ambient.scale,
             ],
             atlas: [rw as f32, rh as f32, vw as f32, vh as f32],
-            real_plane: model
-                .geometry
-                .real_plane()
+            real_plane: self
+                .real_plane
                 .map_or([0.0; 4], |(n, d)| [n.x, n.y, n.z, d]),
         }
     }
@@ -296,7 +273,7 @@ impl SceneRenderer {
             glossy_from_probe: settings.glossy == GlossySource::Environment,
             has_ambient: self.lighting.as_ref().is_some_and(|l| l.ambient.is_some()),
             background_rays: settings.background_rays.clamp(1, 8),
-            flat_real_layer: model.geometry.real_plane().is_some(),
+            flat_real_layer: self.real_plane.is_some(),
         }
     }
 
@@ -401,7 +378,6 @@ impl SceneRenderer {
         }
         self.lights_changed = false;
         self.drawn_placements = Some(placements);
-        self.frame_number = self.frame_number.wrapping_add(1);
         FrameReport {
             cpu_seconds: started.elapsed().as_secs_f64(),
             drew_real_shadows: draw_real && count > 0,
