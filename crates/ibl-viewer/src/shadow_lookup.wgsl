@@ -125,6 +125,19 @@ fn soft_visibility(atlas: texture_depth_2d, map: mat4x4<f32>, tile: vec4<f32>, e
     return lit / 16.0;
 }
 
+// Visibility of light i in one atlas (its tile's map, rectangle and extent): PCSS when the
+// pipeline draws soft shadows and the light has a cone, else one hard tap.
+fn atlas_visibility(i: u32, atlas: texture_depth_2d, map: mat4x4<f32>, tile: vec4<f32>,
+                    extent: vec4<f32>, atlas_size: vec2<f32>, p: vec3<f32>, n: vec3<f32>,
+                    noise: f32) -> f32 {
+    let cos_light = dot(n, lights[i].direction.xyz);
+    if SOFT_SHADOWS && lights[i].direction.w > 0.0 {
+        return soft_visibility(atlas, map, tile, extent, atlas_size, lights[i].direction.w, p, n,
+            cos_light, noise);
+    }
+    return hard_visibility(atlas, map, tile, extent, atlas_size, p, n, cos_light);
+}
+
 // The real geometry lies in one plane (frame.real_plane): a pipeline constant.
 override FLAT_REAL_LAYER: bool = false;
 
@@ -144,22 +157,12 @@ fn real_visibility(i: u32, p: vec3<f32>, n: vec3<f32>, noise: f32) -> f32 {
         return hard_visibility(real_atlas, lights[i].real_map, lights[i].real_tile,
             lights[i].real_extent, frame.atlas.xy, p, n, dot(n, lights[i].direction.xyz));
     }
-    let cos_light = dot(n, lights[i].direction.xyz);
-    if SOFT_SHADOWS && lights[i].direction.w > 0.0 {
-        return soft_visibility(real_atlas, lights[i].real_map, lights[i].real_tile,
-            lights[i].real_extent, frame.atlas.xy, lights[i].direction.w, p, n, cos_light, noise);
-    }
-    return hard_visibility(real_atlas, lights[i].real_map, lights[i].real_tile,
-        lights[i].real_extent, frame.atlas.xy, p, n, cos_light);
+    return atlas_visibility(i, real_atlas, lights[i].real_map, lights[i].real_tile,
+        lights[i].real_extent, frame.atlas.xy, p, n, noise);
 }
 
 // Visibility of light i in the virtual-object atlas.
 fn virtual_visibility(i: u32, p: vec3<f32>, n: vec3<f32>, noise: f32) -> f32 {
-    let cos_light = dot(n, lights[i].direction.xyz);
-    if SOFT_SHADOWS && lights[i].direction.w > 0.0 {
-        return soft_visibility(virtual_atlas, lights[i].virtual_map, lights[i].virtual_tile,
-            lights[i].virtual_extent, frame.atlas.zw, lights[i].direction.w, p, n, cos_light, noise);
-    }
-    return hard_visibility(virtual_atlas, lights[i].virtual_map, lights[i].virtual_tile,
-        lights[i].virtual_extent, frame.atlas.zw, p, n, cos_light);
+    return atlas_visibility(i, virtual_atlas, lights[i].virtual_map, lights[i].virtual_tile,
+        lights[i].virtual_extent, frame.atlas.zw, p, n, noise);
 }
