@@ -321,7 +321,22 @@ fn room_render_writes_before_and_after_and_refuses_bad_edits_before_the_work() {
         e.contains("no surface group `sofa`") && e.contains("floor"),
         "{e}"
     );
+    assert!(
+        !e.contains("estimated in"),
+        "refused before the analysis: {e}"
+    );
     assert!(!out.exists());
+    // The room's probe is never written over, and that is found before the analysis too.
+    let probe = repo().join("assets/probes/apartment.exr");
+    let bytes = std::fs::read(&probe).unwrap();
+    let o = ibl(&["room", "render", &s(&room), "-o", &s(&probe)]);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(
+        !e.contains("estimated in"),
+        "refused before the analysis: {e}"
+    );
+    assert_eq!(std::fs::read(&probe).unwrap(), bytes);
     // A picture that cannot be written is refused before the estimate runs.
     let o = ibl(&[
         "room",

@@ -186,8 +186,18 @@ pub fn estimate_room(
     sampling: &SamplingOptions,
     progress: &dyn Progress,
 ) -> Result<EstimatedRoom> {
+    estimate_read_room(room, read_room(room)?, sampling, progress)
+}
+
+/// [`estimate_room`] on a room file already read (`input`, from `room`): for a job that checks
+/// the room's contents before the analysis starts.
+pub fn estimate_read_room(
+    room: &Path,
+    input: RoomInput,
+    sampling: &SamplingOptions,
+    progress: &dyn Progress,
+) -> Result<EstimatedRoom> {
     let settings = sampling.settings()?;
-    let input = read_room(room)?;
     let probe = read_probe(&input, progress)?;
     let start = Instant::now();
     let analysis = analyse(&input, &probe, &settings, progress)?;

@@ -35,15 +35,16 @@ use ibl_core::{Image, Rgb};
 use ibl_io::WriteOptions;
 use ibl_room::room_radiance::RoomRadiance;
 use ibl_room::{
-    FillTexture, FillTextureSettings, GroupKind, HoleFill, MaterialChange, NovelViewSettings,
-    change_materials, render_novel_view,
+    FillTexture, FillTextureSettings, Group, GroupKind, HoleFill, MaterialChange,
+    NovelViewSettings, Room, change_materials, render_novel_view,
 };
 use ibl_scene::Camera;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{PipelineError, Result};
 use crate::progress::Progress;
-use crate::room_estimate::{EstimatedRoom, SamplingOptions, estimate_room};
+use crate::room_estimate::{EstimatedRoom, SamplingOptions, estimate_read_room};
+use crate::room_input::read_room;
 
 /// Largest edits file read, bytes.
 const MAX_EDITS_BYTES: u64 = 1 << 20;
@@ -353,11 +354,15 @@ pub fn room_render(o: &RoomRenderOptions, progress: &dyn Progress) -> Result<Roo
             o.output.display()
         )));
     }
-    let start = Instant::now();
-    let estimated = estimate_room(&o.room, &o.sampling, progress)?;
+    // The room file is read first: its probe must not be overwritten and the edited groups
+    // must be its surface groups, both checked before the analysis runs.
+    let input = read_room(&o.room)?;
     for out in &outputs {
-        crate::output_paths::check_output_path(out, &[&estimated.input.probe_path])?;
+        crate::output_paths::check_output_path(out, &[&input.probe_path])?;
     }
+    surface_groups(&input.room, &edits, &o.room)?;
+    let start = Instant::now();
+    let estimated = estimate_read_room(&o.room, input, &o.sampling, progress)?;
     let seconds_estimate = start.elapsed().as_secs_f64();
     let pictures = render_edits(&estimated, &edits, &o.room)?;
     let (before, after) = (&pictures.before, &pictures.after);
@@ -497,47 +502,58 @@ pub fn render_edits(
     })
 }
 
-/// The edits' group names as the room's surface groups, with the estimate's reflectances.
+/// The room's group index of each edited group, in the edits' order; an error naming the room's
+/// surface groups for a name that is not one of them.
+fn surface_groups(room: &Room, edits: &RoomEdits, room_path: &Path) -> Result<Vec<usize>> {
+    let is_surface = |g: &&Group| g.kind == GroupKind::Surface;
+    edits
+        .materials
+        .iter()
+        .map(|(name, _)| {
+            room.groups
+                .iter()
+                .position(|g| &g.name == name && is_surface(&g))
+                .ok_or_else(|| {
+                    let surfaces: Vec<&str> = room
+                        .groups
+                        .iter()
+                        .filter(is_surface)
+                        .map(|g| g.name.as_str())
+                        .collect();
+                    PipelineError::parameter(format!(
+                        "{}: no surface group `{name}` (the surface groups are: {})",
+                        room_path.display(),
+                        surfaces.join(", ")
+                    ))
+                })
+        })
+        .collect()
+}
+
+/// The edits as the room's material changes, with the estimate's reflectances before.
 fn resolve_materials(
     estimated: &EstimatedRoom,
     edits: &RoomEdits,
     room_path: &Path,
 ) -> Result<(Vec<MaterialChange>, Vec<MaterialRow>)> {
-    let room = &estimated.input.room;
-    let surfaces: Vec<&str> = room
-        .groups
-        .iter()
-        .filter(|g| g.kind == GroupKind::Surface)
-        .map(|g| g.name.as_str())
-        .collect();
-    let mut changes = Vec::new();
-    let mut rows = Vec::new();
-    for (name, reflectance) in &edits.materials {
-        let index = room
-            .groups
-            .iter()
-            .position(|g| &g.name == name && g.kind == GroupKind::Surface)
-            .ok_or_else(|| {
-                PipelineError::parameter(format!(
-                    "{}: no surface group `{name}` (the surface groups are: {})",
-                    room_path.display(),
-                    surfaces.join(", ")
-                ))
-            })?;
-        let before = estimated.analysis.estimate.groups[index]
-            .reflectance
-            .unwrap_or([0.0; 3]);
-        changes.push(MaterialChange {
-            group: index,
-            reflectance: *reflectance,
-        });
-        rows.push(MaterialRow {
-            group: name.clone(),
-            before,
-            after: reflectance.to_array(),
-        });
-    }
-    Ok((changes, rows))
+    let groups = surface_groups(&estimated.input.room, edits, room_path)?;
+    let estimate = &estimated.analysis.estimate;
+    Ok(groups
+        .into_iter()
+        .zip(&edits.materials)
+        .map(|(group, (name, reflectance))| {
+            let change = MaterialChange {
+                group,
+                reflectance: *reflectance,
+            };
+            let row = MaterialRow {
+                group: name.clone(),
+                before: estimate.groups[group].reflectance.unwrap_or([0.0; 3]),
+                after: reflectance.to_array(),
+            };
+            (change, row)
+        })
+        .unzip())
 }
 
 /// The pinhole camera of a view (+Y up hint; square pixels).
