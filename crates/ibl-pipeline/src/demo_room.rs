@@ -15,7 +15,6 @@ use crate::progress::Progress;
 use crate::room_estimate::{SamplingOptions, estimate_room, report, write_pictures};
 use crate::room_lights::write_lights;
 use crate::room_render::{RoomEdits, render_edits};
-use ibl_core::tonemap::{Display, ToneCurve, auto_exposure_stops};
 
 /// Important patches the demo lists and exports.
 pub const DEMO_IMPORTANT_PATCHES: usize = 16;
@@ -101,19 +100,11 @@ fn manipulations(
         }
         let edits = RoomEdits::read(&path)?;
         let pictures = render_edits(estimated, &edits, room).context(path.display().to_string())?;
-        let options = ibl_io::WriteOptions {
-            display: Display {
-                exposure_stops: auto_exposure_stops(&pictures.before),
-                curve: ToneCurve::AcesFilmic,
-            },
-            ..Default::default()
-        };
         let (before, after) = (
             format!("{prefix}-before.png"),
             format!("{prefix}-after.png"),
         );
-        ibl_io::write_image(&dir.join(&before), &pictures.before, &options)?;
-        ibl_io::write_image(&dir.join(&after), &pictures.after, &options)?;
+        pictures.write(&dir.join(&after), Some(&dir.join(&before)))?;
         out.push(RoomManipulation {
             edits: path.display().to_string(),
             caption: caption.to_string(),

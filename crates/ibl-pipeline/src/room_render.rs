@@ -365,21 +365,9 @@ pub fn room_render(o: &RoomRenderOptions, progress: &dyn Progress) -> Result<Roo
     let estimated = estimate_read_room(&o.room, input, &o.sampling, progress)?;
     let seconds_estimate = start.elapsed().as_secs_f64();
     let pictures = render_edits(&estimated, &edits, &o.room)?;
-    let (before, after) = (&pictures.before, &pictures.after);
-    let stops = auto_exposure_stops(before);
-    let options = WriteOptions {
-        display: Display {
-            exposure_stops: stops,
-            curve: ToneCurve::AcesFilmic,
-        },
-        ..Default::default()
-    };
-    ibl_io::write_image(&o.output, after, &options)?;
-    let mut written = vec![o.output.display().to_string()];
-    if let Some(path) = &o.before {
-        ibl_io::write_image(path, before, &options)?;
-        written.push(path.display().to_string());
-    }
+    let stops = pictures.write(&o.output, o.before.as_deref())?;
+    let after = &pictures.after;
+    let written: Vec<String> = outputs.iter().map(|p| p.display().to_string()).collect();
     Ok(RoomRenderResult {
         room: o.room.display().to_string(),
         kind: if edits.view.is_some() {
@@ -421,6 +409,27 @@ pub struct EditedPictures {
     pub seconds_edit: f64,
     /// Seconds of the pictures.
     pub seconds_render: f64,
+}
+
+impl EditedPictures {
+    /// Writes the picture after the edits to `after` and, when asked, the one before to
+    /// `before`, PNG and JPEG at one exposure (the before picture's automatic one, ACES);
+    /// returns it, stops.
+    pub fn write(&self, after: &Path, before: Option<&Path>) -> Result<f32> {
+        let stops = auto_exposure_stops(&self.before);
+        let options = WriteOptions {
+            display: Display {
+                exposure_stops: stops,
+                curve: ToneCurve::AcesFilmic,
+            },
+            ..Default::default()
+        };
+        ibl_io::write_image(after, &self.after, &options)?;
+        if let Some(path) = before {
+            ibl_io::write_image(path, &self.before, &options)?;
+        }
+        Ok(stops)
+    }
 }
 
 /// Applies `edits` to `estimated` (the room file `room_path`, for messages) and renders the
