@@ -357,4 +357,50 @@ fn room_render_writes_before_and_after_and_refuses_bad_edits_before_the_work() {
         &s(&out),
     ]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+
+    // A light whose file is missing is named, exit 2, before the analysis; the bundled light
+    // edits render and report the light.
+    let missing = dir.path().join("missing-light.toml");
+    std::fs::write(
+        &missing,
+        "version = 1\n[[light]]\nfile = \"nowhere.ies\"\nposition = [0, 2, 0]\n",
+    )
+    .unwrap();
+    let o = ibl(&[
+        "room",
+        "render",
+        &s(&room),
+        "--edit",
+        &s(&missing),
+        "-o",
+        &s(&out),
+    ]);
+    let e = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(
+        e.contains("nowhere.ies") && !e.contains("estimated in"),
+        "{e}"
+    );
+    assert!(!out.exists());
+    let light = repo().join("assets/rooms/apartment/edits-light.toml");
+    let o = ibl(&[
+        "room",
+        "render",
+        &s(&room),
+        "--edit",
+        &s(&light),
+        "-o",
+        &s(&out),
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let summary: Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(
+        summary["lights"][0]["file"]
+            .as_str()
+            .unwrap()
+            .ends_with("umbrella.ies")
+    );
+    assert!(summary["lights"][0]["flux_lm"].as_f64().unwrap() > 8000.0);
+    assert!(out.is_file());
 }

@@ -1,7 +1,7 @@
 //! `ibl room`: the reconstructed room of Grosch 2005 section 3 (`docs/ROOMS.md`): `calibrate`
 //! (marks to frame and scale), `estimate` (room and probe to reflectance and the report),
 //! `lights` (the important patches as an area-light file), `render` (the room after material
-//! changes or from a moved camera). The jobs are `ibl_pipeline::room_calibrate`,
+//! changes, with new lights or from a moved camera). The jobs are `ibl_pipeline::room_calibrate`,
 //! `room_estimate`, `room_lights` and `room_render`.
 
 use std::path::PathBuf;
@@ -29,18 +29,21 @@ enum RoomCommand {
     Estimate(EstimateArgs),
     /// The room's N important light patches as an area-light file for `ibl render --lights`.
     Lights(LightsArgs),
-    /// The room re-rendered after material changes (with colour bleeding) or from a moved camera.
+    /// The room re-rendered after material changes (with colour bleeding), with new IES/LDT
+    /// lights, or from a moved camera.
     Render(RenderArgs),
 }
 
 /// Arguments of `ibl room render`.
 #[derive(Args)]
 #[command(after_help = "\
-The edits file (docs/ROOMS.md section 11): [[material]] changes with bounces of colour bleeding,
-and a [view] from a moved camera (else the edited probe is the output).
+The edits file (docs/ROOMS.md sections 11 and 12): [[material]] changes with bounces of colour
+bleeding, [[light]] goniometric lights (IES LM-63 or EULUMDAT files, placed and turned, with
+shadows and bounced light), and a [view] from a moved camera (else the edited probe is the output).
 
 Examples:
   ibl room render assets/rooms/apartment/room.toml --edit assets/rooms/apartment/edits.toml -o a.png --before b.png
+  ibl room render assets/rooms/apartment/room.toml --edit assets/rooms/apartment/edits-light.toml -o lit.png
   ibl room render room.toml --edit edits.toml -o view.exr --json")]
 struct RenderArgs {
     /// Room file (.toml).

@@ -188,6 +188,7 @@ impl FrameCompositor {
             &Lighting {
                 environment,
                 illumination,
+                luminaires: Vec::new(),
             },
             &settings,
             &|_, _| {},

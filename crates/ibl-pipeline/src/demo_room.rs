@@ -70,12 +70,18 @@ pub struct RoomManipulation {
 }
 
 /// The edits files the demo applies, beside the room file: file, picture prefix, caption.
-const DEMO_EDITS: [(&str, &str, &str); 2] = [
+const DEMO_EDITS: [(&str, &str, &str); 3] = [
     (
         "edits.toml",
         "material",
         "the floor's reflectance changed (Grosch 2005 section 4.3): its radiance scaled by \
          rho'/rho, one bounce of colour bleeding onto the rest of the room",
+    ),
+    (
+        "edits-light.toml",
+        "light",
+        "a new light (section 4.2): a real IES downlight hung by the +x wall, its direct light \
+         EQ5 at every pixel with shadow rays, one bounce of its light by delta radiosity",
     ),
     (
         "edits-view.toml",
@@ -99,7 +105,9 @@ fn manipulations(
             continue;
         }
         let edits = RoomEdits::read(&path)?;
-        let pictures = render_edits(estimated, &edits, room).context(path.display().to_string())?;
+        let lights = edits.load_lights()?;
+        let pictures =
+            render_edits(estimated, &edits, &lights, room).context(path.display().to_string())?;
         let (before, after) = (
             format!("{prefix}-before.png"),
             format!("{prefix}-after.png"),

@@ -3,7 +3,9 @@
 //! radiance scaled by `rho' / rho` at once, then colour bleeding by delta radiosity over the
 //! room's form factors, `bounces` bounces) and a moved camera (section 4.4: the probe projected on
 //! the geometry where it saw, `B / pi` where it did not, optionally modulated by the seen texture
-//! of the same face). Without a `[view]`, the output is the edited probe (lat-long); with one,
+//! of the same face) and new goniometric lights (section 4.2: IES LM-63 or EULUMDAT files placed
+//! and turned in the room, EQ5 per point with shadow rays, their light bounced like a material
+//! change's). Without a `[view]`, the output is the edited probe (lat-long); with one,
 //! the view from the moved camera. `--before` writes the same picture without the edits, at the
 //! same exposure, for side-by-side comparison.
 //!
@@ -15,6 +17,14 @@
 //! group = "floor"                    # a surface group of the room file
 //! reflectance = [0.60, 0.25, 0.20]   # linear RGB in [0, 1]
 //!
+//! [[light]]                          # any number (at most 64): a new goniometric light
+//! file = "../../photometry/ies/overhead.ies"  # .ies or .ldt, relative to the edits file
+//! position = [0.0, 2.2, -1.0]        # metres, world frame
+//! rotation_deg = [0.0, 20.0, 0.0]    # yaw, pitch, roll of the light (0: aimed straight down)
+//! colour = [1.0, 0.86, 0.7]          # its chromaticity (linear Rec. 709), default white
+//! peak_intensity = 40.0              # normalised: the table's peak, probe units per sr; or
+//! # nits_per_unit = 1.0              # absolute: cd/m^2 of a probe value of 1 (the default)
+//!
 //! [view]                             # optional: a camera moved inside the room
 //! position = [0.5, 1.2, 0.0]         # metres, world frame (docs/CONVENTIONS.md)
 //! look_at = [0.0, 1.0, -2.0]
@@ -24,19 +34,22 @@
 //! samples_per_axis = 2
 //! ```
 //!
-//! Paths in the edits file: none. Unknown keys are refused with their name and line.
+//! Paths in the edits file: the lights' files, relative to the edits file. Unknown keys are
+//! refused with their name and line.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use glam::{Vec2, Vec3};
+use ibl_core::EulerDegrees;
 use ibl_core::tonemap::{Display, ToneCurve, auto_exposure_stops};
 use ibl_core::{Image, Rgb};
 use ibl_io::WriteOptions;
+use ibl_light::{GoniometricLight, intensity_per_candela_for};
 use ibl_room::room_radiance::RoomRadiance;
 use ibl_room::{
-    FillTexture, FillTextureSettings, Group, GroupKind, HoleFill, MaterialChange,
-    NovelViewSettings, Room, change_materials, render_novel_view,
+    FillTexture, FillTextureSettings, Group, GroupKind, HoleFill, LightAdditionSettings,
+    MaterialChange, NovelViewSettings, Room, add_lights, change_materials, render_novel_view,
 };
 use ibl_scene::Camera;
 use serde::{Deserialize, Serialize};
@@ -58,7 +71,26 @@ struct EditsFile {
     bounces: u32,
     #[serde(default)]
     material: Vec<MaterialEntry>,
+    #[serde(default)]
+    light: Vec<LightEntry>,
     view: Option<ViewEntry>,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct LightEntry {
+    file: PathBuf,
+    position: [f32; 3],
+    #[serde(default)]
+    rotation_deg: [f32; 3],
+    #[serde(default = "white")]
+    colour: [f32; 3],
+    nits_per_unit: Option<f32>,
+    peak_intensity: Option<f32>,
+}
+
+fn white() -> [f32; 3] {
+    [1.0; 3]
 }
 
 #[derive(Clone, Debug, Deserialize)]
@@ -118,13 +150,72 @@ pub struct ViewEdit {
     pub samples_per_axis: u32,
 }
 
+/// Most new lights in one edits file.
+pub const MAX_LIGHTS: usize = 64;
+
+/// How a light's candela become the probe's radiance unit (CONVENTIONS section 6).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum IntensityScale {
+    /// Absolute: a probe value of 1 is this many cd/m^2, so the light delivers `I / k` probe
+    /// units of radiance times sr.
+    NitsPerUnit(f32),
+    /// Normalised: the table scaled so that its peak is this many probe units per sr (the
+    /// probe's scale unknown, the light set by eye).
+    PeakIntensity(f32),
+}
+
+/// A new goniometric light as the edits file places it (its file not read yet).
+#[derive(Clone, Debug, PartialEq)]
+pub struct LightSpec {
+    /// The `.ies` or `.ldt` file, resolved against the edits file's folder.
+    pub file: PathBuf,
+    /// Position, metres, world frame.
+    pub position: Vec3,
+    /// Yaw, pitch and roll of the light's frame, degrees (0: aimed straight down).
+    pub rotation_deg: [f32; 3],
+    /// Its chromaticity, linear Rec. 709 (only the ratios count).
+    pub colour: Rgb,
+    /// Candela to the probe's unit.
+    pub scale: IntensityScale,
+}
+
+/// A light read from its file and placed.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LoadedLight {
+    /// The light, world frame, in the probe's unit.
+    pub light: GoniometricLight,
+    /// What is reported of it.
+    pub row: LightRow,
+}
+
+/// One new light, as `--json` reports it.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct LightRow {
+    /// Its file.
+    pub file: String,
+    /// The luminaire's name in the file.
+    pub name: String,
+    /// Position, metres, world frame.
+    pub position: [f32; 3],
+    /// The table's luminous flux (its exact integral), lm.
+    pub flux_lm: f64,
+    /// What the file states the luminaire emits, lm (when it says).
+    pub stated_lm: Option<f64>,
+    /// The table's peak, cd.
+    pub peak_cd: f32,
+    /// The peak in the probe's unit per sr (luminance-weighted).
+    pub peak_intensity: f32,
+}
+
 /// A checked edits file.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RoomEdits {
-    /// Bounces of colour bleeding.
+    /// Bounces of colour bleeding (of the changed materials and of the new lights).
     pub bounces: u32,
     /// Surface group name and its new reflectance, in file order.
     pub materials: Vec<(String, Rgb)>,
+    /// New goniometric lights, in file order.
+    pub lights: Vec<LightSpec>,
     /// The moved camera, if any.
     pub view: Option<ViewEdit>,
 }
@@ -135,6 +226,7 @@ impl RoomEdits {
         RoomEdits {
             bounces: 1,
             materials: Vec::new(),
+            lights: Vec::new(),
             view: None,
         }
     }
@@ -179,6 +271,19 @@ impl RoomEdits {
             }
             materials.push((m.group.clone(), Rgb::from_array(m.reflectance)));
         }
+        if file.light.len() > MAX_LIGHTS {
+            return Err(bad(format!(
+                "{} lights (at most {MAX_LIGHTS})",
+                file.light.len()
+            )));
+        }
+        let folder = path.parent().unwrap_or(Path::new(""));
+        let lights = file
+            .light
+            .iter()
+            .enumerate()
+            .map(|(k, l)| check_light(l, folder).map_err(|m| bad(format!("light[{k}]: {m}"))))
+            .collect::<Result<Vec<_>>>()?;
         let view = match &file.view {
             None => None,
             Some(v) => Some(check_view(v).map_err(|m| bad(format!("[view] {m}")))?),
@@ -186,9 +291,88 @@ impl RoomEdits {
         Ok(RoomEdits {
             bounces: file.bounces,
             materials,
+            lights,
             view,
         })
     }
+
+    /// Reads every light's file and places it; errors name the file and the problem.
+    pub fn load_lights(&self) -> Result<Vec<LoadedLight>> {
+        self.lights.iter().map(load_light).collect()
+    }
+}
+
+fn check_light(l: &LightEntry, folder: &Path) -> std::result::Result<LightSpec, String> {
+    let finite = |a: &[f32; 3]| a.iter().all(|x| x.is_finite());
+    if !finite(&l.position) || !finite(&l.rotation_deg) {
+        return Err("position and rotation_deg must be finite".into());
+    }
+    let colour = Rgb::from_array(l.colour);
+    if !colour.is_valid_radiance() || colour.luminance() <= 0.0 {
+        return Err(format!(
+            "colour {:?} must be finite, not negative and not black",
+            l.colour
+        ));
+    }
+    let positive = |v: f32| v.is_finite() && v > 0.0;
+    let scale = match (l.nits_per_unit, l.peak_intensity) {
+        (Some(_), Some(_)) => {
+            return Err(
+                "give nits_per_unit (absolute) or peak_intensity (normalised), not both".into(),
+            );
+        }
+        (Some(k), None) if positive(k) => IntensityScale::NitsPerUnit(k),
+        (None, Some(p)) if positive(p) => IntensityScale::PeakIntensity(p),
+        (None, None) => IntensityScale::NitsPerUnit(1.0),
+        _ => return Err("nits_per_unit and peak_intensity must be positive and finite".into()),
+    };
+    Ok(LightSpec {
+        file: folder.join(&l.file),
+        position: Vec3::from(l.position),
+        rotation_deg: l.rotation_deg,
+        colour,
+        scale,
+    })
+}
+
+/// Reads `spec`'s photometric file and makes the light.
+fn load_light(spec: &LightSpec) -> Result<LoadedLight> {
+    let file = ibl_io::photometry::read_photometry(&spec.file)?;
+    let table = file.table().clone();
+    let peak_cd = table.peak();
+    let nits_per_unit = match spec.scale {
+        IntensityScale::NitsPerUnit(k) => k,
+        IntensityScale::PeakIntensity(p) => peak_cd / p,
+    };
+    let intensity_per_candela = intensity_per_candela_for(spec.colour, nits_per_unit);
+    if peak_cd <= 0.0 || intensity_per_candela.max_channel() <= 0.0 {
+        return Err(PipelineError::parameter(format!(
+            "{}: the luminaire emits no light (peak {peak_cd} cd)",
+            spec.file.display()
+        )));
+    }
+    let [yaw_deg, pitch_deg, roll_deg] = spec.rotation_deg;
+    let light = GoniometricLight {
+        position: spec.position,
+        world_from_light: EulerDegrees {
+            yaw_deg,
+            pitch_deg,
+            roll_deg,
+        }
+        .world_from_probe(),
+        table,
+        intensity_per_candela,
+    };
+    let row = LightRow {
+        file: spec.file.display().to_string(),
+        name: file.name().to_string(),
+        position: spec.position.to_array(),
+        flux_lm: light.table.flux(),
+        stated_lm: file.stated_flux().luminaire_lumens(),
+        peak_cd,
+        peak_intensity: peak_cd / nits_per_unit,
+    };
+    Ok(LoadedLight { light, row })
 }
 
 fn check_view(v: &ViewEntry) -> std::result::Result<ViewEdit, String> {
@@ -264,7 +448,9 @@ pub struct RoomRenderResult {
     pub height: usize,
     /// The groups changed, with their reflectance before and after.
     pub materials: Vec<MaterialRow>,
-    /// Bounces of colour bleeding made.
+    /// The lights added.
+    pub lights: Vec<LightRow>,
+    /// Bounces of colour bleeding made (of the changed materials and of the new lights).
     pub bounces: u32,
     /// The last bounce's largest change relative to the largest radiosity (what another bounce
     /// would add, roughly).
@@ -275,7 +461,7 @@ pub struct RoomRenderResult {
     pub exposure_stops: f32,
     /// Seconds: the estimate (depth map, form factors, radiosity), the edit, the picture(s).
     pub seconds_estimate: f64,
-    /// Seconds of the material edit (direct change and bleeding).
+    /// Seconds of the edit (the material change, the new lights' patch means, the bleeding).
     pub seconds_edit: f64,
     /// Seconds of rendering the picture(s).
     pub seconds_render: f64,
@@ -293,10 +479,23 @@ impl RoomRenderResult {
                 m.group, m.before, m.after
             );
         }
-        if !self.materials.is_empty() {
+        for l in &self.lights {
             text += &format!(
-                "; {} bounces of colour bleeding (the last changed {:.2} %)",
+                "; light {} at {:.2?}: {:.0} lm{}, peak {:.0} cd = {:.3} probe units/sr",
+                l.file,
+                l.position,
+                l.flux_lm,
+                l.stated_lm
+                    .map_or(String::new(), |s| format!(" (the file states {s:.0})")),
+                l.peak_cd,
+                l.peak_intensity
+            );
+        }
+        if !self.materials.is_empty() || !self.lights.is_empty() {
+            text += &format!(
+                "; {} bounce{} of colour bleeding (the last changed {:.2} %)",
                 self.bounces,
+                if self.bounces == 1 { "" } else { "s" },
                 100.0 * self.last_bounce_relative
             );
         }
@@ -336,6 +535,7 @@ pub fn room_render(o: &RoomRenderOptions, progress: &dyn Progress) -> Result<Roo
     };
     let mut inputs: Vec<&Path> = vec![&o.room];
     inputs.extend(o.edits.as_deref());
+    inputs.extend(edits.lights.iter().map(|l| l.file.as_path()));
     let outputs: Vec<&Path> = std::iter::once(o.output.as_path())
         .chain(o.before.as_deref())
         .collect();
@@ -361,10 +561,11 @@ pub fn room_render(o: &RoomRenderOptions, progress: &dyn Progress) -> Result<Roo
         crate::output_paths::check_output_path(out, &[&input.probe_path])?;
     }
     surface_groups(&input.room, &edits, &o.room)?;
+    let lights = edits.load_lights()?;
     let start = Instant::now();
     let estimated = estimate_read_room(&o.room, input, &o.sampling, progress)?;
     let seconds_estimate = start.elapsed().as_secs_f64();
-    let pictures = render_edits(&estimated, &edits, &o.room)?;
+    let pictures = render_edits(&estimated, &edits, &lights, &o.room)?;
     let stops = pictures.write(&o.output, o.before.as_deref())?;
     let after = &pictures.after;
     let written: Vec<String> = outputs.iter().map(|p| p.display().to_string()).collect();
@@ -378,6 +579,7 @@ pub fn room_render(o: &RoomRenderOptions, progress: &dyn Progress) -> Result<Roo
         width: after.width(),
         height: after.height(),
         materials: pictures.materials.clone(),
+        lights: pictures.lights.clone(),
         bounces: pictures.bounces,
         last_bounce_relative: pictures.last_bounce_relative,
         filled_fraction: pictures.filled_fraction,
@@ -399,6 +601,8 @@ pub struct EditedPictures {
     pub after: Image<Rgb>,
     /// The groups changed.
     pub materials: Vec<MaterialRow>,
+    /// The lights added.
+    pub lights: Vec<LightRow>,
     /// Bounces of colour bleeding made.
     pub bounces: u32,
     /// The last bounce's relative change.
@@ -432,11 +636,12 @@ impl EditedPictures {
     }
 }
 
-/// Applies `edits` to `estimated` (the room file `room_path`, for messages) and renders the
-/// pictures before and after.
+/// Applies `edits` to `estimated` (the room file `room_path`, for messages), with the edits'
+/// lights as `lights` ([`RoomEdits::load_lights`]), and renders the pictures before and after.
 pub fn render_edits(
     estimated: &EstimatedRoom,
     edits: &RoomEdits,
+    lights: &[LoadedLight],
     room_path: &Path,
 ) -> Result<EditedPictures> {
     let (changes, rows) = resolve_materials(estimated, edits, room_path)?;
@@ -451,12 +656,37 @@ pub fn render_edits(
         &changes,
         edits.bounces,
     )?;
-    let after_probe = edit.panorama(&analysis.depth, &estimated.probe)?;
+    // The new lights reflect off the edited materials and bounce as often as their change.
+    let addition = if lights.is_empty() {
+        None
+    } else {
+        let settings = LightAdditionSettings {
+            bounces: edits.bounces,
+            ..LightAdditionSettings::default()
+        };
+        let placed = lights.iter().map(|l| l.light.clone()).collect();
+        Some(add_lights(
+            room,
+            &edit.reflectance,
+            &analysis.form_factors,
+            placed,
+            &settings,
+        )?)
+    };
+    // The probe with the edited materials: the texture a moved camera sees (the lights are
+    // added at each point it shows).
+    let edited_probe = edit.panorama(&analysis.depth, &estimated.probe)?;
     let seconds_edit = start.elapsed().as_secs_f64();
 
     let start = Instant::now();
     let (before, after, filled_fraction) = match &edits.view {
-        None => (estimated.probe.clone(), after_probe, None),
+        None => {
+            let after = match &addition {
+                Some(a) => a.panorama(room, &analysis.depth, &edited_probe)?,
+                None => edited_probe,
+            };
+            (estimated.probe.clone(), after, None)
+        }
         Some(view) => {
             let mut edited_estimate = analysis.estimate.clone();
             for (patch, b) in edited_estimate.patches.iter_mut().zip(&edit.radiosity) {
@@ -480,8 +710,7 @@ pub fn render_edits(
             let settings = NovelViewSettings {
                 samples_per_axis: view.samples_per_axis,
             };
-            let render = |probe: &Image<Rgb>, estimate| -> Result<ibl_room::NovelView> {
-                let field = RoomRadiance::new(room, &analysis.depth, probe, estimate)?;
+            let render = |field: RoomRadiance| -> Result<ibl_room::NovelView> {
                 Ok(render_novel_view(
                     &field,
                     &camera,
@@ -491,20 +720,33 @@ pub fn render_edits(
                     &settings,
                 )?)
             };
-            let before = render(&estimated.probe, &analysis.estimate)?;
-            let after = render(&after_probe, &edited_estimate)?;
+            let before = render(RoomRadiance::new(
+                room,
+                &analysis.depth,
+                &estimated.probe,
+                &analysis.estimate,
+            )?)?;
+            let field = RoomRadiance::new(room, &analysis.depth, &edited_probe, &edited_estimate)?;
+            let after = render(match &addition {
+                Some(a) => field.with_added_light(a),
+                None => field,
+            })?;
             let filled = after.filled_mask();
             let n = filled.pixels().iter().filter(|&&f| f).count();
             let fraction = n as f64 / filled.pixels().len().max(1) as f64;
             (before.image, after.image, Some(fraction))
         }
     };
+    let last_bounce_relative = edit
+        .last_bounce_relative
+        .max(addition.as_ref().map_or(0.0, |a| a.last_bounce_relative));
     Ok(EditedPictures {
         before,
         after,
         materials: rows,
+        lights: lights.iter().map(|l| l.row.clone()).collect(),
         bounces: edit.bounces,
-        last_bounce_relative: edit.last_bounce_relative,
+        last_bounce_relative,
         filled_fraction,
         seconds_edit,
         seconds_render: start.elapsed().as_secs_f64(),

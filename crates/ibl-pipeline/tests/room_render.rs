@@ -47,6 +47,23 @@ fn bad_edits_are_refused_with_the_file_and_the_problem() {
         "version = 1\n[view]\nposition = [0, 1, 0]\nlook_at = [1, 1, 0]\nsize = [0, 10]\n",
         "size 0 x 10",
     );
+    let light = "version = 1\n[[light]]\nfile = \"a.ies\"\nposition = [0, 2, 0]\n";
+    refused(
+        &format!("{light}nits_per_unit = 1.0\npeak_intensity = 3.0\n"),
+        "not both",
+    );
+    refused(&format!("{light}colour = [0, 0, 0]\n"), "not black");
+    refused(&format!("{light}peak_intensity = -3.0\n"), "positive");
+    refused(
+        "version = 1\n[[light]]\nfile = \"a.ies\"\nposition = [0, nan, 0]\n",
+        "finite",
+    );
+    // The light's file is resolved against the edits file's folder and read on request; a
+    // missing one is an error naming it.
+    let edits = RoomEdits::parse(light, &apartment().join("e.toml")).unwrap();
+    assert_eq!(edits.lights[0].file, apartment().join("a.ies"));
+    let e = edits.load_lights().unwrap_err().to_string();
+    assert!(e.contains("a.ies"), "{e}");
     let ok = RoomEdits::read(&apartment().join("edits.toml")).unwrap();
     assert_eq!(ok.materials.len(), 1);
     assert!(ok.view.is_none());
@@ -85,7 +102,7 @@ fn the_apartment_floor_turns_red_and_bleeds_onto_the_walls() {
     let room = apartment().join("room.toml");
     let estimated = estimate_room(&room, &SamplingOptions::default(), &Silent).unwrap();
     let edits = RoomEdits::read(&apartment().join("edits.toml")).unwrap();
-    let pictures = render_edits(&estimated, &edits, &room).unwrap();
+    let pictures = render_edits(&estimated, &edits, &[], &room).unwrap();
     assert_eq!(pictures.before, estimated.probe, "before is the probe");
     let r = &estimated.input.room;
     let floor = r.groups.iter().position(|g| g.name == "floor").unwrap();
@@ -134,7 +151,7 @@ fn the_apartment_floor_turns_red_and_bleeds_onto_the_walls() {
 
     // The moved camera shows the same change.
     let edits = RoomEdits::read(&apartment().join("edits-view.toml")).unwrap();
-    let view = render_edits(&estimated, &edits, &room).unwrap();
+    let view = render_edits(&estimated, &edits, &[], &room).unwrap();
     assert_eq!((view.after.width(), view.after.height()), (480, 360));
     let bottom = mean_ratio(&view.before, &view.after, |_, j| j > 330);
     assert!(
@@ -142,4 +159,73 @@ fn the_apartment_floor_turns_red_and_bleeds_onto_the_walls() {
         "the floor at the view's bottom is redder: {bottom:?}"
     );
     assert!(view.filled_fraction.is_some());
+}
+
+#[test]
+fn the_apartment_gets_the_downlight_pool_eq5_predicts() {
+    let room = apartment().join("room.toml");
+    let estimated = estimate_room(&room, &SamplingOptions::default(), &Silent).unwrap();
+    let edits = RoomEdits::read(&apartment().join("edits-light.toml")).unwrap();
+    let lights = edits.load_lights().unwrap();
+    let pictures = render_edits(&estimated, &edits, &lights, &room).unwrap();
+    assert_eq!(pictures.before, estimated.probe, "before is the probe");
+    let row = &pictures.lights[0];
+    // The table's flux is its exact integral (ibl-light), and the scale puts its peak at the
+    // asked 40 probe units per sr.
+    assert!((row.flux_lm - lights[0].light.table.flux()).abs() < 1e-9);
+    assert!((row.peak_intensity - 40.0).abs() < 1e-3, "{row:?}");
+    // A light only adds: no pixel darkens (beyond f32 rounding).
+    for (b, a) in pictures.before.pixels().iter().zip(pictures.after.pixels()) {
+        for c in 0..3 {
+            assert!(a[c] >= b[c] - 1e-6 * b[c].abs().max(1.0), "{b:?} -> {a:?}");
+        }
+    }
+    // The floor right below the light: EQ5 at the nadir, `E = I(0) / h^2`, reflected as
+    // `rho E / pi` with the floor patch's estimated reflectance, plus the patch's share of the
+    // light's first bounce (off the lit +x wall 0.48 m away and the floor around: 14 % of the
+    // direct light there, validated against the path tracer in ibl-room's tests/added_light.rs).
+    // The pixel's footprint (about 2 cm on the floor) changes E by under 0.1 %.
+    let r = &estimated.input.room;
+    let light = &lights[0].light;
+    let below = glam::Vec3::new(light.position.x, 0.0, light.position.z);
+    let to = r.world_from_probe.transpose() * (below - r.probe_position);
+    let (i, j) = ibl_core::LatLong::new(pictures.after.width(), pictures.after.height())
+        .dir_to_pixel(to.normalize().as_dvec3());
+    let patch = estimated.analysis.depth.sample(i, j).patch as usize;
+    assert_eq!(r.groups[r.patches[patch].group as usize].name, "floor");
+    let reflectance: Vec<Rgb> = estimated
+        .analysis
+        .estimate
+        .patches
+        .iter()
+        .map(|p| p.reflectance)
+        .collect();
+    let addition = ibl_room::add_lights(
+        r,
+        &reflectance,
+        &estimated.analysis.form_factors,
+        vec![light.clone()],
+        &ibl_room::LightAdditionSettings::default(),
+    )
+    .unwrap();
+    let indirect = addition.indirect_radiosity[patch] / std::f32::consts::PI;
+    let e = light.intensity_towards(-glam::Vec3::Y) / (light.position.y * light.position.y);
+    let added = *pictures.after.get(i, j) - *pictures.before.get(i, j);
+    for c in 0..3 {
+        let direct = reflectance[patch][c] * e[c] / std::f32::consts::PI;
+        eprintln!(
+            "channel {c}: added {:.4} = rho E / pi {direct:.4} + indirect {:.4}",
+            added[c], indirect[c]
+        );
+        assert!(
+            ((added[c] - indirect[c]) / direct - 1.0).abs() < 1e-3,
+            "channel {c}: {added:?} against {direct} + {indirect:?}"
+        );
+        assert!(
+            indirect[c] > 0.0 && indirect[c] < 0.2 * direct,
+            "{indirect:?}"
+        );
+    }
+    // The pool is seen: the light adds more than the window gives the floor there.
+    assert!(added.g > pictures.before.get(i, j).g, "{added:?}");
 }

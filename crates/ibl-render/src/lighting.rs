@@ -27,6 +27,15 @@
 //! direction alike: near-black patches on the bunny. The vertex's light (lights plus ambient) is
 //! clamped at 0 per channel.
 //!
+//! **Goniometric lights** (Grosch 2005 section 4.2, new light sources): in every mode the
+//! lighting may also hold point lights with measured intensity distributions
+//! ([`Lighting::luminaires`], `ibl_light::GoniometricLight`, positioned in the world frame). A
+//! diffuse or glossy vertex adds `f cos(theta_i) I(-w_i) / d^2` for each (EQ5 times the BSDF),
+//! with one shadow ray to the light's position: a delta light, so it is exact and noise-free, and
+//! neither the camera nor a BSDF sample can meet it. In the reference every path vertex adds it
+//! (next-event estimation: the light's indirect share comes from the later vertices); in the
+//! lights and hybrid modes only the one vertex they shade.
+//!
 //! In every mode the environment is still what a perfect mirror reflects and what the camera sees
 //! where it sees no geometry; only diffuse and glossy reflection use the approximation. Lights come
 //! from the probe in its own frame and are rotated by `world_from_probe` here, as is the ambient.
@@ -35,7 +44,7 @@ use std::f64::consts::TAU;
 
 use glam::{DMat3, DVec3, Vec3};
 use ibl_core::Rgb;
-use ibl_light::LightSet;
+use ibl_light::{GoniometricLight, LightSet};
 use ibl_scene::{Scene, ShadowKind};
 use ibl_sh::{RadianceSh, basis, eval_basis};
 
@@ -127,6 +136,9 @@ pub struct Lighting {
     pub environment: EnvironmentLight,
     /// What diffuse and glossy surfaces are lit by.
     pub illumination: Illumination,
+    /// Goniometric point lights added to the scene (world frame, the probe's radiance unit per
+    /// sr), lighting diffuse and glossy surfaces in every mode; none by default.
+    pub luminaires: Vec<GoniometricLight>,
 }
 
 impl Lighting {
@@ -144,6 +156,7 @@ impl Lighting {
         Ok(Lighting {
             environment: Self::environment(scene)?,
             illumination: Illumination::Environment,
+            luminaires: Vec::new(),
         })
     }
 
@@ -156,6 +169,7 @@ impl Lighting {
         Ok(Lighting {
             environment: Self::environment(scene)?,
             illumination: Illumination::Lights(light_list(scene, set, shadows)),
+            luminaires: Vec::new(),
         })
     }
 
@@ -180,7 +194,14 @@ impl Lighting {
                 light_list(scene, set, shadows),
                 Ambient::new(&ambient.rotated(rotation), occlusion_rays),
             ),
+            luminaires: Vec::new(),
         })
+    }
+
+    /// The same lighting with the goniometric point lights `luminaires` added.
+    pub fn with_luminaires(mut self, luminaires: Vec<GoniometricLight>) -> Lighting {
+        self.luminaires.extend(luminaires);
+        self
     }
 }
 

@@ -19,6 +19,10 @@
 //!   occlusion rays: `albedo * mean_k V(w_k) L_a(w_k)` (directional occlusion,
 //!   [`crate::lighting`]).
 //!
+//! In every mode the lighting's goniometric point lights ([`Lighting::luminaires`]) are added at
+//! each vertex that takes direct light (every vertex of the reference, the one vertex of the
+//! other modes), each through a shadow ray that stops at the light.
+//!
 //! Ray origins leave a surface by its hit point's error bound (pbrt-v4 section 6.8.6): the point
 //! moves along the geometric normal by `d = |n| . err` (`err` the per-axis bound of
 //! [`SurfacePoint::position_error`]) to the side the ray leaves on, and each coordinate is
@@ -218,8 +222,16 @@ impl<'a> Tracer<'a> {
             if !bsdf.is_delta() {
                 match &self.lighting.illumination {
                     Illumination::Environment => {
+                        let vertex = Vertex {
+                            surface: &surface,
+                            bsdf: &bsdf,
+                            wo,
+                        };
+                        let none = LayeredLight::none(&state);
+                        let luminaires = self.luminaires(&vertex, &mut state, none);
                         radiance += throughput
-                            * self.environment_sample(&surface, &bsdf, wo, stream, &mut state);
+                            * (self.environment_sample(&surface, &bsdf, wo, stream, &mut state)
+                                + luminaires.with);
                     }
                     Illumination::Lights(list) => {
                         let none = LayeredLight::none(&state);
@@ -228,7 +240,8 @@ impl<'a> Tracer<'a> {
                             bsdf: &bsdf,
                             wo,
                         };
-                        let direct = self.lights(list, &vertex, stream, &mut state, none);
+                        let direct = self.lights(list, &vertex, stream, &mut state, none)
+                            + self.luminaires(&vertex, &mut state, none);
                         without_objects = direct
                             .without
                             .map(|w| radiance + throughput * w.map(|v| v.max(0.0)));
@@ -243,6 +256,7 @@ impl<'a> Tracer<'a> {
                             wo,
                         };
                         let direct = self.lights(list, &vertex, stream, &mut state, none)
+                            + self.luminaires(&vertex, &mut state, none)
                             + self.ambient(ambient, &surface, stream, &mut state, none);
                         without_objects = direct
                             .without
@@ -341,6 +355,40 @@ impl<'a> Tracer<'a> {
         sum
     }
 
+    /// Every goniometric point light (Grosch 2005 EQ5 times the BSDF): `f cos(theta_i) I(-w_i) /
+    /// d^2`, `w_i` the unit direction to the light and `d` its distance, with a shadow ray that
+    /// stops at the light (a light below the geometric surface sends none).
+    fn luminaires(
+        &self,
+        vertex: &Vertex,
+        state: &mut PathState,
+        mut sum: LayeredLight,
+    ) -> LayeredLight {
+        if self.lighting.luminaires.is_empty() {
+            return sum;
+        }
+        let origin = above(vertex.surface);
+        for light in &self.lighting.luminaires {
+            let to_light = light.position - origin;
+            let d2 = to_light.length_squared();
+            if !(d2 > 0.0 && d2.is_finite()) {
+                continue;
+            }
+            let distance = d2.sqrt();
+            let wi = to_light / distance;
+            let Some(f_cos) = reflection(vertex.surface, vertex.bsdf, vertex.wo, wi) else {
+                continue;
+            };
+            let intensity = light.intensity_towards(-wi);
+            if intensity.max_channel() <= 0.0 {
+                continue;
+            }
+            let occlusion = self.occlusion_within(origin, wi, distance, state);
+            sum.add(occlusion, f_cos * intensity / d2);
+        }
+        sum
+    }
+
     /// The hybrid ambient: `albedo * mean_k V(w_k) L_a(w_k)` over cosine-distributed `w_k`.
     fn ambient(
         &self,
@@ -391,17 +439,25 @@ impl<'a> Tracer<'a> {
     /// What blocks the direction `wi` from `origin` (a point just above a surface, [`above`]),
     /// to infinity: the lights and the environment are distant.
     fn occlusion(&self, origin: Vec3, wi: Vec3, state: &mut PathState) -> Occlusion {
+        self.occlusion_within(origin, wi, f32::INFINITY, state)
+    }
+
+    /// What blocks the segment from `origin` along the unit `wi` to distance `t_max` (a point
+    /// light there: what lies beyond it does not shadow).
+    fn occlusion_within(
+        &self,
+        origin: Vec3,
+        wi: Vec3,
+        t_max: f32,
+        state: &mut PathState,
+    ) -> Occlusion {
         state.rays += 1;
         let ray = Ray::new(origin, wi);
-        if self.scene.real.bvh.occluded(&ray, 0.0, f32::INFINITY) {
+        if self.scene.real.bvh.occluded(&ray, 0.0, t_max) {
             return Occlusion::Real;
         }
         if state.layers == Layers::WithObjects
-            && self
-                .scene
-                .virtual_objects
-                .bvh
-                .occluded(&ray, 0.0, f32::INFINITY)
+            && self.scene.virtual_objects.bvh.occluded(&ray, 0.0, t_max)
         {
             state.touched_virtual = true;
             return Occlusion::Virtual;

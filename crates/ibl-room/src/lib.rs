@@ -23,7 +23,8 @@
 //!   [`mod@volume_error`] (its interpolation error against direct gathering), [`material_change`]
 //!   (new reflectances and colour bleeding by delta radiosity, 4.3), [`novel_view`] (the room
 //!   from a moved camera, 4.4) with [`fill_texture`] (its fill modulated by the seen texture,
-//!   beyond the paper).
+//!   beyond the paper), [`added_light`] (new goniometric lights, direct per point and their
+//!   bounces by delta radiosity, 4.2).
 //! - Geometry from the probe (3.1): [`view`] (perspective views of the panorama), [`marks`] (the
 //!   marks file), [`vanishing`] (vanishing points, axes, `world_from_probe`), [`scale`],
 //!   [`placement`] (shapes by constraints, the room file they make); beyond the paper,
@@ -31,6 +32,7 @@
 //!
 //! This crate does no file I/O: it parses and writes text; `ibl-io` and the front ends own files.
 
+pub mod added_light;
 pub mod ambient_cube;
 pub mod analysis;
 pub mod depth_map;
@@ -60,6 +62,7 @@ pub mod vanishing;
 pub mod view;
 pub mod volume_error;
 
+pub use added_light::{LightAddition, LightAdditionSettings, add_lights};
 pub use analysis::{AnalysisSettings, RoomAnalysis, Stage, analyse_room};
 pub use depth_map::ProbeDepthMap;
 pub use description::{GroupKind, RoomDescription, RoomFile};

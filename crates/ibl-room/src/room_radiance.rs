@@ -13,10 +13,16 @@
 //! depth changes by `d tan(theta)` per radian there; one more millimetre absorbs f32 rounding.
 //! The texture is the probe pixel in `x`'s direction (nearest pixel, as the depth test). World
 //! frame and metres as `docs/CONVENTIONS.md`; radiance in the probe's units.
+//!
+//! **New lights** ([`RoomRadiance::with_added_light`], section 4.2): their radiance at `x`
+//! ([`LightAddition::radiance_at`], direct light per point with its shadow ray, indirect per
+//! patch) is added on both sides of the depth test, so a moved camera sees their pools and
+//! shadows at its own resolution rather than the probe's.
 
 use glam::Vec3;
 use ibl_core::{Image, LatLong, Rgb};
 
+use crate::added_light::LightAddition;
 use crate::depth_map::ProbeDepthMap;
 use crate::reflectance::Estimate;
 use crate::{Room, RoomError};
@@ -47,6 +53,8 @@ pub struct RoomRadiance<'a> {
     probe: &'a Image<Rgb>,
     /// Per patch, the estimate's radiance `B / pi`.
     estimate: Vec<Rgb>,
+    /// New lights whose radiance is added everywhere.
+    added: Option<&'a LightAddition>,
 }
 
 impl<'a> RoomRadiance<'a> {
@@ -83,7 +91,15 @@ impl<'a> RoomRadiance<'a> {
                 .iter()
                 .map(|p| p.radiosity / std::f32::consts::PI)
                 .collect(),
+            added: None,
         })
+    }
+
+    /// The same field with the radiance of the new lights `added` (made for this room) added at
+    /// every point.
+    pub fn with_added_light(mut self, added: &'a LightAddition) -> RoomRadiance<'a> {
+        self.added = Some(added);
+        self
     }
 
     /// The room.
@@ -93,6 +109,15 @@ impl<'a> RoomRadiance<'a> {
 
     /// The radiance leaving world point `point` of patch `patch`, and whether it is the probe's.
     pub fn at(&self, point: Vec3, patch: usize) -> (Rgb, bool) {
+        let (radiance, seen) = self.before_lights(point, patch);
+        match self.added {
+            Some(added) => (radiance + added.radiance_at(self.room, patch, point), seen),
+            None => (radiance, seen),
+        }
+    }
+
+    /// [`Self::at`] without the new lights.
+    fn before_lights(&self, point: Vec3, patch: usize) -> (Rgb, bool) {
         let distance = (point - self.room.probe_position).length();
         let tolerance = distance * STEEPEST_VIEW_TAN * std::f32::consts::PI
             / (2.0 * self.depth.height() as f32)
