@@ -1,7 +1,7 @@
 //! Fuzz target: a room edits file's text (`ibl-pipeline::room_render`, read by
 //! `ibl room render --edit`) must parse to checked edits or an error naming the file, for any
 //! bytes, never panic; parsed edits hold only reflectances in [0, 1], at most 64 lights with
-//! finite placements and a bounded view. Parsing reads no file (the lights' files are read by
+//! finite placements, at most 64 objects and a bounded view. Parsing reads no file (the lights' files are read by
 //! `RoomEdits::load_lights`, the photometry readers having their own targets).
 #![no_main]
 
@@ -18,6 +18,8 @@ fuzz_target!(|data: &[u8]| {
                 assert!(rho.to_array().iter().all(|v| (0.0..=1.0).contains(v)));
             }
             assert!(edits.lights.len() <= ibl_pipeline::room_render::MAX_LIGHTS);
+            assert!(edits.objects.len() <= ibl_pipeline::room_render::MAX_OBJECTS);
+            assert!((1..=ibl_pipeline::room_render::MAX_IMPORTANT_PATCHES).contains(&edits.important_patches));
             for l in &edits.lights {
                 assert!(l.position.is_finite() && l.rotation_deg.iter().all(|a| a.is_finite()));
                 assert!(l.colour.luminance() > 0.0);

@@ -55,7 +55,7 @@ pub use photometry::{
     PhotometricFile, PhotometryLimits, StatedFlux, read_photometry, read_photometry_with_limits,
 };
 pub use sanitize::{SanitizeReport, sanitize};
-pub use scene_file::{LoadedScene, read_scene};
+pub use scene_file::{LoadedScene, read_meshes, read_scene};
 pub use sh_file::{ShFile, ShFileFormat, ShQuantity, read_sh_file, write_sh_file};
 pub use texture::{DecodedTexture, TexelFormat, Texture, TextureKind, TextureLevel};
 

@@ -45,6 +45,51 @@ pub fn parse_scene(path: &Path, text: &str) -> Result<SceneDescription, IoError>
     SceneDescription::from_toml(text).map_err(|e| invalid(path, e.to_string()))
 }
 
+/// The meshes of `entries` (the `table` entries of the file `path`: a scene's `local` or
+/// `object`, an edits file's `object`), files relative to `path`'s folder: one entry per
+/// description, `None` for shapes; with the files read. Errors name `path`, the field and the
+/// mesh file.
+pub fn read_meshes(
+    path: &Path,
+    table: &str,
+    entries: &[GeometryDescription],
+) -> Result<(Vec<Option<MeshAsset>>, Vec<PathBuf>), IoError> {
+    let folder = path.parent().unwrap_or(Path::new("."));
+    let limits = MeshLimits::default();
+    let mut files = Vec::new();
+    let meshes = entries
+        .iter()
+        .enumerate()
+        .map(|(i, entry)| match (entry.shape, &entry.file) {
+            (ShapeKind::Mesh, Some(file)) => {
+                let p = folder.join(file);
+                let loaded = read_mesh(&p, &limits)
+                    .map_err(|e| asset_error(path, &format!("{table}[{i}].file"), e))?;
+                files.push(p);
+                Ok(Some(MeshAsset {
+                    mesh: loaded.mesh,
+                    base_albedo: loaded.base_colors,
+                }))
+            }
+            _ => Ok(None),
+        })
+        .collect::<Result<Vec<_>, IoError>>()?;
+    Ok((meshes, files))
+}
+
+/// An asset's error, prefixed by the file `path` and the field that named it.
+fn asset_error(path: &Path, field: &str, e: IoError) -> IoError {
+    let message = format!("{field}: {e}");
+    if e.is_bad_input() {
+        invalid(path, message)
+    } else {
+        IoError::Io {
+            path: path.to_path_buf(),
+            source: std::io::Error::other(message),
+        }
+    }
+}
+
 /// Reads a scene file and everything it names.
 pub fn read_scene(path: &Path) -> Result<LoadedScene, IoError> {
     let size = std::fs::metadata(path)
@@ -63,23 +108,9 @@ pub fn read_scene(path: &Path) -> Result<LoadedScene, IoError> {
     let resolve = |p: &Path| folder.join(p);
     let mut inputs = vec![path.to_path_buf()];
 
-    // An asset's error, prefixed by the scene file and the field that named it.
-    let asset_error = |field: &str, e: IoError| -> IoError {
-        let bad = e.is_bad_input();
-        let message = format!("{field}: {e}");
-        if bad {
-            invalid(path, message)
-        } else {
-            IoError::Io {
-                path: path.to_path_buf(),
-                source: std::io::Error::other(message),
-            }
-        }
-    };
-
     let probe_path = resolve(&description.probe.file);
     let probe = crate::read_image(&probe_path)
-        .map_err(|e| asset_error("probe.file", e))?
+        .map_err(|e| asset_error(path, "probe.file", e))?
         .image;
     if probe.width() != 2 * probe.height() {
         return Err(invalid(
@@ -99,7 +130,7 @@ pub fn read_scene(path: &Path) -> Result<LoadedScene, IoError> {
             (BackgroundKind::Photo, Some(file)) => {
                 let p = resolve(file);
                 let image = crate::read_image(&p)
-                    .map_err(|e| asset_error("background.file", e))?
+                    .map_err(|e| asset_error(path, "background.file", e))?
                     .image;
                 inputs.push(p);
                 Some(image)
@@ -107,29 +138,10 @@ pub fn read_scene(path: &Path) -> Result<LoadedScene, IoError> {
             _ => None,
         };
 
-    let limits = MeshLimits::default();
-    let mut load =
-        |table: &str, entries: &[GeometryDescription]| -> Result<Vec<Option<MeshAsset>>, IoError> {
-            entries
-                .iter()
-                .enumerate()
-                .map(|(i, entry)| match (entry.shape, &entry.file) {
-                    (ShapeKind::Mesh, Some(file)) => {
-                        let p = resolve(file);
-                        let loaded = read_mesh(&p, &limits)
-                            .map_err(|e| asset_error(&format!("{table}[{i}].file"), e))?;
-                        inputs.push(p);
-                        Ok(Some(MeshAsset {
-                            mesh: loaded.mesh,
-                            base_albedo: loaded.base_colors,
-                        }))
-                    }
-                    _ => Ok(None),
-                })
-                .collect()
-        };
-    let local = load("local", &description.local)?;
-    let objects = load("object", &description.object)?;
+    let (local, local_paths) = read_meshes(path, "local", &description.local)?;
+    let (objects, object_paths) = read_meshes(path, "object", &description.object)?;
+    inputs.extend(local_paths);
+    inputs.extend(object_paths);
     let lights_path = description.lighting.lights_file.as_deref().map(resolve);
     if let Some(p) = &lights_path {
         inputs.push(p.clone());

@@ -70,7 +70,7 @@ pub struct RoomManipulation {
 }
 
 /// The edits files the demo applies, beside the room file: file, picture prefix, caption.
-const DEMO_EDITS: [(&str, &str, &str); 3] = [
+const DEMO_EDITS: [(&str, &str, &str); 4] = [
     (
         "edits.toml",
         "material",
@@ -82,6 +82,13 @@ const DEMO_EDITS: [(&str, &str, &str); 3] = [
         "light",
         "a new light (section 4.2): a real IES downlight hung by the +x wall, its direct light \
          EQ5 at every pixel with shadow rays, one bounce of its light by delta radiosity",
+    ),
+    (
+        "edits-object.toml",
+        "object",
+        "a virtual object (section 4.1): the bunny in the sunlit patch, Grosch's improved display \
+         (the irradiance volume's unimportant light, 32 important patches recomputed with \
+         shadows), its shadows subtracted from the probe",
     ),
     (
         "edits-view.toml",
@@ -105,9 +112,9 @@ fn manipulations(
             continue;
         }
         let edits = RoomEdits::read(&path)?;
-        let lights = edits.load_lights()?;
+        let assets = edits.load()?;
         let pictures =
-            render_edits(estimated, &edits, &lights, room).context(path.display().to_string())?;
+            render_edits(estimated, &edits, &assets, room).context(path.display().to_string())?;
         let (before, after) = (
             format!("{prefix}-before.png"),
             format!("{prefix}-after.png"),

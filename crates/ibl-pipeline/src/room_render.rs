@@ -5,7 +5,9 @@
 //! the geometry where it saw, `B / pi` where it did not, optionally modulated by the seen texture
 //! of the same face) and new goniometric lights (section 4.2: IES LM-63 or EULUMDAT files placed
 //! and turned in the room, EQ5 per point with shadow rays, their light bounced like a material
-//! change's). Without a `[view]`, the output is the edited probe (lat-long); with one,
+//! change's) and virtual objects (section 4.1: the fast or improved display, their shadows
+//! subtracted from the probe; not yet with lights or a view). Without a `[view]`, the output is
+//! the edited probe (lat-long); with one,
 //! the view from the moved camera. `--before` writes the same picture without the edits, at the
 //! same exposure, for side-by-side comparison.
 //!
@@ -24,6 +26,15 @@
 //! colour = [1.0, 0.86, 0.7]          # its chromaticity (linear Rec. 709), default white
 //! peak_intensity = 40.0              # normalised: the table's peak, probe units per sr; or
 //! # nits_per_unit = 1.0              # absolute: cd/m^2 of a probe value of 1 (the default)
+//!
+//! display = "improved"               # virtual objects: Grosch's "improved" or "fast" display
+//! important_patches = 32             # the patches that light them and cast their shadows
+//! [[object]]                         # any number (at most 64), as a scene file's [[object]]
+//! shape = "mesh"                     # sphere, box, plane or mesh (file relative to this file)
+//! file = "../../models/bunny.glb"
+//! scale = 0.25
+//! translate = [1.45, 0.223, -0.75]
+//! material = { kind = "diffuse", albedo = [0.75, 0.75, 0.75] }
 //!
 //! [view]                             # optional: a camera moved inside the room
 //! position = [0.5, 1.2, 0.0]         # metres, world frame (docs/CONVENTIONS.md)
@@ -48,10 +59,13 @@ use ibl_io::WriteOptions;
 use ibl_light::{GoniometricLight, intensity_per_candela_for};
 use ibl_room::room_radiance::RoomRadiance;
 use ibl_room::{
-    FillTexture, FillTextureSettings, Group, GroupKind, HoleFill, LightAdditionSettings,
-    MaterialChange, NovelViewSettings, Room, add_lights, change_materials, render_novel_view,
+    DisplayMode, FillTexture, FillTextureSettings, Group, GroupKind, HoleFill,
+    LightAdditionSettings, MaterialChange, NovelViewSettings, ObjectDisplay, ObjectDisplaySettings,
+    Room, RoomVolume, VolumeSettings, add_lights, change_materials, important_patches,
+    render_novel_view,
 };
-use ibl_scene::Camera;
+use ibl_scene::description::GeometryDescription;
+use ibl_scene::{Camera, GeometryLayer};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{PipelineError, Result};
@@ -73,8 +87,27 @@ struct EditsFile {
     material: Vec<MaterialEntry>,
     #[serde(default)]
     light: Vec<LightEntry>,
+    #[serde(default)]
+    object: Vec<GeometryDescription>,
+    #[serde(default = "default_display")]
+    display: String,
+    #[serde(default = "default_important")]
+    important_patches: usize,
     view: Option<ViewEntry>,
 }
+
+fn default_display() -> String {
+    "improved".into()
+}
+
+fn default_important() -> usize {
+    32
+}
+
+/// Most virtual objects in one edits file.
+pub const MAX_OBJECTS: usize = 64;
+/// Most important patches asked for.
+pub const MAX_IMPORTANT_PATCHES: usize = 1024;
 
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -188,6 +221,19 @@ pub struct LoadedLight {
     pub row: LightRow,
 }
 
+/// The virtual objects, as `--json` reports them.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ObjectRow {
+    /// Their names.
+    pub names: Vec<String>,
+    /// Triangles in all.
+    pub triangles: usize,
+    /// `fast` or `improved` (Grosch 2005 section 4.1).
+    pub display: &'static str,
+    /// Important patches lighting them and casting their shadows.
+    pub important_patches: usize,
+}
+
 /// One new light, as `--json` reports it.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct LightRow {
@@ -216,8 +262,25 @@ pub struct RoomEdits {
     pub materials: Vec<(String, Rgb)>,
     /// New goniometric lights, in file order.
     pub lights: Vec<LightSpec>,
+    /// Virtual objects, as a scene file's `[[object]]` entries (meshes not read yet).
+    pub objects: Vec<GeometryDescription>,
+    /// How the objects are displayed (Grosch's fast or improved display).
+    pub display: DisplayMode,
+    /// Important patches that light the objects and cast their shadows.
+    pub important_patches: usize,
     /// The moved camera, if any.
     pub view: Option<ViewEdit>,
+    /// The edits file (its objects' mesh files are relative to it).
+    pub source: PathBuf,
+}
+
+/// What an edits file names, read: its lights and its objects.
+#[derive(Clone, Debug)]
+pub struct EditAssets {
+    /// The lights, placed.
+    pub lights: Vec<LoadedLight>,
+    /// The virtual objects, when there are any.
+    pub objects: Option<GeometryLayer>,
 }
 
 impl RoomEdits {
@@ -227,7 +290,11 @@ impl RoomEdits {
             bounces: 1,
             materials: Vec::new(),
             lights: Vec::new(),
+            objects: Vec::new(),
+            display: DisplayMode::Improved,
+            important_patches: 32,
             view: None,
+            source: PathBuf::new(),
         }
     }
 
@@ -288,12 +355,55 @@ impl RoomEdits {
             None => None,
             Some(v) => Some(check_view(v).map_err(|m| bad(format!("[view] {m}")))?),
         };
+        if file.object.len() > MAX_OBJECTS {
+            return Err(bad(format!(
+                "{} objects (at most {MAX_OBJECTS})",
+                file.object.len()
+            )));
+        }
+        if !file.object.is_empty() && (!lights.is_empty() || view.is_some()) {
+            return Err(bad(
+                "virtual objects are displayed in the probe's panorama with material changes; \
+                 with [[light]] or a [view] they are not supported yet (docs/ROOMS.md section 13)"
+                    .into(),
+            ));
+        }
+        let display = match file.display.as_str() {
+            "improved" => DisplayMode::Improved,
+            "fast" => DisplayMode::Fast,
+            other => return Err(bad(format!("display `{other}` (improved or fast)"))),
+        };
+        if !(1..=MAX_IMPORTANT_PATCHES).contains(&file.important_patches) {
+            return Err(bad(format!(
+                "important_patches = {} (1 to {MAX_IMPORTANT_PATCHES})",
+                file.important_patches
+            )));
+        }
         Ok(RoomEdits {
             bounces: file.bounces,
             materials,
             lights,
+            objects: file.object,
+            display,
+            important_patches: file.important_patches,
             view,
+            source: path.to_path_buf(),
         })
+    }
+
+    /// Reads what the edits name: the lights' files and the objects' meshes, and checks the
+    /// objects as a scene file's (errors name the file, the field and the problem).
+    pub fn load(&self) -> Result<EditAssets> {
+        let lights = self.load_lights()?;
+        let objects = if self.objects.is_empty() {
+            None
+        } else {
+            let (meshes, _) = ibl_io::read_meshes(&self.source, "object", &self.objects)?;
+            let layer = ibl_scene::virtual_layer(&self.objects, meshes)
+                .map_err(|e| PipelineError::parameter(format!("{}: {e}", self.source.display())))?;
+            Some(layer)
+        };
+        Ok(EditAssets { lights, objects })
     }
 
     /// Reads every light's file and places it; errors name the file and the problem.
@@ -450,6 +560,8 @@ pub struct RoomRenderResult {
     pub materials: Vec<MaterialRow>,
     /// The lights added.
     pub lights: Vec<LightRow>,
+    /// The objects inserted, if any.
+    pub objects: Option<ObjectRow>,
     /// Bounces of colour bleeding made (of the changed materials and of the new lights).
     pub bounces: u32,
     /// The last bounce's largest change relative to the largest radiosity (what another bounce
@@ -489,6 +601,15 @@ impl RoomRenderResult {
                     .map_or(String::new(), |s| format!(" (the file states {s:.0})")),
                 l.peak_cd,
                 l.peak_intensity
+            );
+        }
+        if let Some(o) = &self.objects {
+            text += &format!(
+                "; {} object(s) ({} triangles), the {} display with {} important patches",
+                o.names.len(),
+                o.triangles,
+                o.display,
+                o.important_patches
             );
         }
         if !self.materials.is_empty() || !self.lights.is_empty() {
@@ -536,6 +657,13 @@ pub fn room_render(o: &RoomRenderOptions, progress: &dyn Progress) -> Result<Roo
     let mut inputs: Vec<&Path> = vec![&o.room];
     inputs.extend(o.edits.as_deref());
     inputs.extend(edits.lights.iter().map(|l| l.file.as_path()));
+    let folder = edits.source.parent().unwrap_or(Path::new("."));
+    let mesh_files: Vec<PathBuf> = edits
+        .objects
+        .iter()
+        .filter_map(|o| o.file.as_ref().map(|f| folder.join(f)))
+        .collect();
+    inputs.extend(mesh_files.iter().map(PathBuf::as_path));
     let outputs: Vec<&Path> = std::iter::once(o.output.as_path())
         .chain(o.before.as_deref())
         .collect();
@@ -561,11 +689,11 @@ pub fn room_render(o: &RoomRenderOptions, progress: &dyn Progress) -> Result<Roo
         crate::output_paths::check_output_path(out, &[&input.probe_path])?;
     }
     surface_groups(&input.room, &edits, &o.room)?;
-    let lights = edits.load_lights()?;
+    let assets = edits.load()?;
     let start = Instant::now();
     let estimated = estimate_read_room(&o.room, input, &o.sampling, progress)?;
     let seconds_estimate = start.elapsed().as_secs_f64();
-    let pictures = render_edits(&estimated, &edits, &lights, &o.room)?;
+    let pictures = render_edits(&estimated, &edits, &assets, &o.room)?;
     let stops = pictures.write(&o.output, o.before.as_deref())?;
     let after = &pictures.after;
     let written: Vec<String> = outputs.iter().map(|p| p.display().to_string()).collect();
@@ -580,6 +708,7 @@ pub fn room_render(o: &RoomRenderOptions, progress: &dyn Progress) -> Result<Roo
         height: after.height(),
         materials: pictures.materials.clone(),
         lights: pictures.lights.clone(),
+        objects: pictures.objects.clone(),
         bounces: pictures.bounces,
         last_bounce_relative: pictures.last_bounce_relative,
         filled_fraction: pictures.filled_fraction,
@@ -603,6 +732,8 @@ pub struct EditedPictures {
     pub materials: Vec<MaterialRow>,
     /// The lights added.
     pub lights: Vec<LightRow>,
+    /// The objects inserted, if any.
+    pub objects: Option<ObjectRow>,
     /// Bounces of colour bleeding made.
     pub bounces: u32,
     /// The last bounce's relative change.
@@ -636,14 +767,15 @@ impl EditedPictures {
     }
 }
 
-/// Applies `edits` to `estimated` (the room file `room_path`, for messages), with the edits'
-/// lights as `lights` ([`RoomEdits::load_lights`]), and renders the pictures before and after.
+/// Applies `edits` to `estimated` (the room file `room_path`, for messages), with what the edits
+/// name as `assets` ([`RoomEdits::load`]), and renders the pictures before and after.
 pub fn render_edits(
     estimated: &EstimatedRoom,
     edits: &RoomEdits,
-    lights: &[LoadedLight],
+    assets: &EditAssets,
     room_path: &Path,
 ) -> Result<EditedPictures> {
+    let lights = &assets.lights;
     let (changes, rows) = resolve_materials(estimated, edits, room_path)?;
 
     let start = Instant::now();
@@ -681,17 +813,25 @@ pub fn render_edits(
     let start = Instant::now();
     let (before, after, filled_fraction) = match &edits.view {
         None => {
-            let after = match &addition {
-                Some(a) => a.panorama(room, &analysis.depth, &edited_probe)?,
-                None => edited_probe,
+            let after = match (&addition, &assets.objects) {
+                (Some(a), _) => a.panorama(room, &analysis.depth, &edited_probe)?,
+                (None, Some(objects)) => {
+                    let estimate = edited_estimate(estimated, &edit.radiosity);
+                    display_objects(
+                        estimated,
+                        &estimate,
+                        &edited_probe,
+                        &edit.reflectance,
+                        objects,
+                        edits,
+                    )?
+                }
+                (None, None) => edited_probe,
             };
             (estimated.probe.clone(), after, None)
         }
         Some(view) => {
-            let mut edited_estimate = analysis.estimate.clone();
-            for (patch, b) in edited_estimate.patches.iter_mut().zip(&edit.radiosity) {
-                patch.radiosity = *b;
-            }
+            let edited_estimate = edited_estimate(estimated, &edit.radiosity);
             let texture = if view.textured {
                 Some(FillTexture::new(
                     room,
@@ -745,12 +885,52 @@ pub fn render_edits(
         after,
         materials: rows,
         lights: lights.iter().map(|l| l.row.clone()).collect(),
+        objects: assets.objects.as_ref().map(|o| ObjectRow {
+            names: o.object_names.clone(),
+            triangles: o.triangle_count(),
+            display: match edits.display {
+                DisplayMode::Fast => "fast",
+                DisplayMode::Improved => "improved",
+            },
+            important_patches: edits.important_patches,
+        }),
         bounces: edit.bounces,
         last_bounce_relative,
         filled_fraction,
         seconds_edit,
         seconds_render: start.elapsed().as_secs_f64(),
     })
+}
+
+/// The estimate with the edit's radiosity.
+fn edited_estimate(estimated: &EstimatedRoom, radiosity: &[Rgb]) -> ibl_room::Estimate {
+    let mut estimate = estimated.analysis.estimate.clone();
+    for (patch, b) in estimate.patches.iter_mut().zip(radiosity) {
+        patch.radiosity = *b;
+    }
+    estimate
+}
+
+/// The objects composited into `probe` (the edited probe, its room as `estimate` has it): the
+/// important patches, the irradiance volume of the edited room, Grosch's display.
+fn display_objects(
+    estimated: &EstimatedRoom,
+    estimate: &ibl_room::Estimate,
+    probe: &Image<Rgb>,
+    reflectance: &[Rgb],
+    objects: &GeometryLayer,
+    edits: &RoomEdits,
+) -> Result<Image<Rgb>> {
+    let room = &estimated.input.room;
+    let field = RoomRadiance::new(room, &estimated.analysis.depth, probe, estimate)?;
+    let important = important_patches(room, estimate, edits.important_patches);
+    let volume: RoomVolume = RoomVolume::build(&field, &important, &VolumeSettings::default())?;
+    let settings = ObjectDisplaySettings {
+        mode: edits.display,
+        ..ObjectDisplaySettings::default()
+    };
+    let display = ObjectDisplay::new(&field, &volume, &important, reflectance, objects, settings)?;
+    Ok(display.panorama(probe)?.image)
 }
 
 /// The room's group index of each edited group, in the edits' order; an error naming the room's

@@ -102,7 +102,7 @@ fn the_apartment_floor_turns_red_and_bleeds_onto_the_walls() {
     let room = apartment().join("room.toml");
     let estimated = estimate_room(&room, &SamplingOptions::default(), &Silent).unwrap();
     let edits = RoomEdits::read(&apartment().join("edits.toml")).unwrap();
-    let pictures = render_edits(&estimated, &edits, &[], &room).unwrap();
+    let pictures = render_edits(&estimated, &edits, &edits.load().unwrap(), &room).unwrap();
     assert_eq!(pictures.before, estimated.probe, "before is the probe");
     let r = &estimated.input.room;
     let floor = r.groups.iter().position(|g| g.name == "floor").unwrap();
@@ -151,7 +151,7 @@ fn the_apartment_floor_turns_red_and_bleeds_onto_the_walls() {
 
     // The moved camera shows the same change.
     let edits = RoomEdits::read(&apartment().join("edits-view.toml")).unwrap();
-    let view = render_edits(&estimated, &edits, &[], &room).unwrap();
+    let view = render_edits(&estimated, &edits, &edits.load().unwrap(), &room).unwrap();
     assert_eq!((view.after.width(), view.after.height()), (480, 360));
     let bottom = mean_ratio(&view.before, &view.after, |_, j| j > 330);
     assert!(
@@ -166,8 +166,9 @@ fn the_apartment_gets_the_downlight_pool_eq5_predicts() {
     let room = apartment().join("room.toml");
     let estimated = estimate_room(&room, &SamplingOptions::default(), &Silent).unwrap();
     let edits = RoomEdits::read(&apartment().join("edits-light.toml")).unwrap();
-    let lights = edits.load_lights().unwrap();
-    let pictures = render_edits(&estimated, &edits, &lights, &room).unwrap();
+    let assets = edits.load().unwrap();
+    let lights = &assets.lights;
+    let pictures = render_edits(&estimated, &edits, &assets, &room).unwrap();
     assert_eq!(pictures.before, estimated.probe, "before is the probe");
     let row = &pictures.lights[0];
     // The table's flux is its exact integral (ibl-light), and the scale puts its peak at the
@@ -228,4 +229,68 @@ fn the_apartment_gets_the_downlight_pool_eq5_predicts() {
     }
     // The pool is seen: the light adds more than the window gives the floor there.
     assert!(added.g > pictures.before.get(i, j).g, "{added:?}");
+}
+
+#[test]
+fn the_apartment_gets_the_bunny_and_its_shadow() {
+    let room = apartment().join("room.toml");
+    let estimated = estimate_room(&room, &SamplingOptions::default(), &Silent).unwrap();
+    let edits = RoomEdits::read(&apartment().join("edits-object.toml")).unwrap();
+    let assets = edits.load().unwrap();
+    let pictures = render_edits(&estimated, &edits, &assets, &room).unwrap();
+    let row = pictures.objects.as_ref().unwrap();
+    assert_eq!(
+        (row.names.clone(), row.display),
+        (vec!["bunny".to_string()], "improved")
+    );
+    let (w, h) = (pictures.after.width(), pictures.after.height());
+    // Where the bunny stands: its direction from the probe, and the pixels around it change.
+    let r = &estimated.input.room;
+    let feet = glam::Vec3::new(1.45, 0.1, -0.75);
+    let to = r.world_from_probe.transpose() * (feet - r.probe_position);
+    let (i, j) = ibl_core::LatLong::new(w, h).dir_to_pixel(to.normalize().as_dvec3());
+    let change = |x: usize, y: usize| {
+        let (b, a) = (pictures.before.get(x, y).g, pictures.after.get(x, y).g);
+        (a - b).abs() / b.max(1e-3)
+    };
+    let near = (j.saturating_sub(6)..(j + 6).min(h))
+        .flat_map(|y| (i.saturating_sub(6)..(i + 6).min(w)).map(move |x| (x, y)))
+        .filter(|&(x, y)| change(x, y) > 0.2)
+        .count();
+    assert!(
+        near > 20,
+        "{near} pixels around the bunny changed by over 20 %"
+    );
+    // The ceiling's top rows, far from it, keep their radiance within 1 %.
+    for y in 0..8 {
+        for x in 0..w {
+            assert!(
+                change(x, y) < 0.01,
+                "pixel ({x}, {y}) changed {}",
+                change(x, y)
+            );
+        }
+    }
+    // Objects with lights or a moved camera are refused for now, naming the file.
+    let text = "version = 1\n[[object]]\nshape = \"sphere\"\nradius = 0.2\n\
+                [[light]]\nfile = \"a.ies\"\nposition = [0, 2, 0]\n";
+    let e = RoomEdits::parse(text, Path::new("e.toml"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("e.toml") && e.contains("not supported yet"),
+        "{e}"
+    );
+    let e = RoomEdits::parse("version = 1\ndisplay = \"best\"\n", Path::new("e.toml"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("display `best`"), "{e}");
+    // A bad object is named with its field, from the scene-file checks.
+    let bad = RoomEdits::parse(
+        "version = 1\n[[object]]\nshape = \"sphere\"\n",
+        &apartment().join("e.toml"),
+    )
+    .unwrap();
+    let e = bad.load().unwrap_err().to_string();
+    assert!(e.contains("object[0]") && e.contains("radius"), "{e}");
 }

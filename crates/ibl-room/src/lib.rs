@@ -24,7 +24,8 @@
 //!   (new reflectances and colour bleeding by delta radiosity, 4.3), [`novel_view`] (the room
 //!   from a moved camera, 4.4) with [`fill_texture`] (its fill modulated by the seen texture,
 //!   beyond the paper), [`added_light`] (new goniometric lights, direct per point and their
-//!   bounces by delta radiosity, 4.2).
+//!   bounces by delta radiosity, 4.2), [`virtual_objects`] (objects inserted, Grosch's fast and
+//!   improved displays, their shadows on the room, 4.1).
 //! - Geometry from the probe (3.1): [`view`] (perspective views of the panorama), [`marks`] (the
 //!   marks file), [`vanishing`] (vanishing points, axes, `world_from_probe`), [`scale`],
 //!   [`placement`] (shapes by constraints, the room file they make); beyond the paper,
@@ -60,6 +61,7 @@ pub mod room_radiance;
 pub mod scale;
 pub mod vanishing;
 pub mod view;
+pub mod virtual_objects;
 pub mod volume_error;
 
 pub use added_light::{LightAddition, LightAdditionSettings, add_lights};
@@ -84,4 +86,5 @@ pub use room_radiance::RoomRadiance;
 pub use scale::{Scale, probe_height};
 pub use vanishing::{Calibration, calibrate, line_observations};
 pub use view::PerspectiveView;
+pub use virtual_objects::{DisplayMode, ObjectDisplay, ObjectDisplaySettings, ObjectPicture};
 pub use volume_error::{VolumeError, VolumeErrorSettings, volume_error};

@@ -38,5 +38,5 @@ pub use patch::PatchAttributes;
 pub use ray::{Hit, Ray};
 pub use scene::{
     Background, GeometryLayer, LayerError, MeshAsset, PlacedMesh, Probe, Scene, SurfacePoint,
-    SurfaceTriangle,
+    SurfaceTriangle, virtual_layer,
 };

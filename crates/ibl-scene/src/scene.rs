@@ -395,6 +395,19 @@ impl Scene {
     }
 }
 
+/// Virtual objects described as a scene file's `[[object]]` entries (an edits file's too), each
+/// checked as a scene's are (`object[i]` in messages), with their meshes as loaded (`None` for
+/// shapes; one entry per description).
+pub fn virtual_layer(
+    entries: &[GeometryDescription],
+    meshes: Vec<Option<MeshAsset>>,
+) -> Result<GeometryLayer, DescriptionError> {
+    for (i, entry) in entries.iter().enumerate() {
+        entry.validate(&format!("object[{i}]"), crate::description::Layer::Virtual)?;
+    }
+    layer("object", entries, meshes, LayerKind::Virtual)
+}
+
 #[derive(Clone, Copy, PartialEq, Eq)]
 enum LayerKind {
     Real,

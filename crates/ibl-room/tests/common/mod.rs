@@ -2,6 +2,9 @@
 //! tracer (material changes, new lights), and the path-traced panoramas and error measure the
 //! validations share.
 
+// Each test binary that includes this module uses a part of it.
+#![allow(dead_code)]
+
 use glam::{Mat3, Vec3};
 use ibl_core::{Image, Rgb};
 use ibl_light::GoniometricLight;
@@ -52,6 +55,22 @@ pub fn render_halves(
     width: u32,
     spp: u32,
 ) -> [Image<Rgb>; 2] {
+    let empty = ibl_scene::GeometryLayer::empty();
+    render_with_objects(room, albedo, luminaires, &empty, position, width, spp)
+        .map(|out| out.with_objects)
+}
+
+/// As [`render_halves`], with `objects` as the virtual layer: each half's images with and
+/// without them (differential rendering: a path that never meets an object is the same in both).
+pub fn render_with_objects(
+    room: &Room,
+    albedo: &[Rgb],
+    luminaires: &[GoniometricLight],
+    objects: &ibl_scene::GeometryLayer,
+    position: Vec3,
+    width: u32,
+    spp: u32,
+) -> [ibl_render::RenderOutput; 2] {
     use ibl_render::{Lighting, RenderSettings, SamplerKind, render};
     use ibl_scene::description::{CompositeRule, LightingDescription, RenderDescription};
     use ibl_scene::{Background, Camera, GeometryLayer, Material, Probe, Scene};
@@ -61,7 +80,7 @@ pub fn render_halves(
     });
     let scene = Scene {
         real: GeometryLayer::new(meshes),
-        virtual_objects: GeometryLayer::empty(),
+        virtual_objects: objects.clone(),
         probe: Probe {
             radiance: Image::filled(64, 32, SKY),
             world_from_probe: Mat3::IDENTITY,
@@ -87,9 +106,7 @@ pub fn render_halves(
             seed,
             sampler: SamplerKind::Sobol,
         };
-        render(&scene, &lighting, &settings, &|_, _| ())
-            .expect("render")
-            .with_objects
+        render(&scene, &lighting, &settings, &|_, _| ()).expect("render")
     })
 }
 

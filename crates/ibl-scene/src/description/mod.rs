@@ -40,7 +40,7 @@ pub use background::{BackgroundDescription, BackgroundKind};
 pub use camera::CameraDescription;
 pub use field::DescriptionError;
 use field::invalid;
-use geometry::Layer;
+pub(crate) use geometry::Layer;
 pub use geometry::{GeometryDescription, Scale, ShapeKind};
 pub use lighting::{LightingDescription, ShadowKind};
 pub use material::{
