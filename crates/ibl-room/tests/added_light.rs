@@ -9,7 +9,7 @@
 
 mod common;
 
-use common::{PROBE, SIDE_VIEW, WINDOW_ROOM, mean, noise_of_mean, relative_mse, render_halves};
+use common::{PROBE, SIDE_VIEW, mean, noise_of_mean, relative_mse, render_halves, window_room};
 use glam::{Mat3, Vec3};
 use ibl_core::{Image, Rgb};
 use ibl_light::{GoniometricLight, intensity_per_candela_for};
@@ -17,8 +17,7 @@ use ibl_room::reflectance::PatchRole;
 use ibl_room::room_radiance::RoomRadiance;
 use ibl_room::{
     AnalysisSettings, GroupKind, HoleFill, LightAdditionSettings, NovelViewSettings,
-    ObservationSettings, ProbeDepthMap, Room, RoomDescription, add_lights, analyse_room,
-    render_novel_view,
+    ObservationSettings, ProbeDepthMap, Room, add_lights, analyse_room, render_novel_view,
 };
 use ibl_scene::Camera;
 
@@ -67,14 +66,7 @@ struct Validations {
 }
 
 fn validate(width: u32, spp: u32) -> Validations {
-    let description: RoomDescription = toml::from_str(WINDOW_ROOM).expect("room parses");
-    let room = Room::new(&description, PROBE, Mat3::IDENTITY).expect("room");
-    let side = Room::new(&description, SIDE_VIEW, Mat3::IDENTITY).expect("room");
-    let albedo: Vec<Rgb> = room
-        .groups
-        .iter()
-        .map(|g| g.measured_reflectance.unwrap_or(Rgb::ZERO))
-        .collect();
+    let (room, side, albedo) = window_room();
     let light = [downlight()];
     let before = mean(&render_halves(&room, &albedo, &[], PROBE, width, spp));
     let before_side = mean(&render_halves(&room, &albedo, &[], SIDE_VIEW, width, spp));

@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{PROBE, SIDE_VIEW, WINDOW_ROOM, mean, noise_of_mean, relative_mse, render_halves};
+use common::{PROBE, SIDE_VIEW, mean, noise_of_mean, relative_mse, render_halves, window_room};
 use glam::{Mat3, Vec3};
 use ibl_core::{Image, Rgb};
 use ibl_room::depth_map::NO_PATCH;
@@ -186,14 +186,7 @@ struct Validations {
 /// changed wall and the other surfaces as the probe sees them, and the surfaces hidden from the
 /// probe as the side view sees them (`width` pixels wide panoramas, `spp` samples per pixel).
 fn validate(width: u32, spp: u32) -> Validations {
-    let description: RoomDescription = toml::from_str(WINDOW_ROOM).expect("room parses");
-    let room = Room::new(&description, PROBE, Mat3::IDENTITY).expect("room");
-    let side = Room::new(&description, SIDE_VIEW, Mat3::IDENTITY).expect("room");
-    let albedo: Vec<Rgb> = room
-        .groups
-        .iter()
-        .map(|g| g.measured_reflectance.unwrap_or(Rgb::ZERO))
-        .collect();
+    let (room, side, albedo) = window_room();
     let accent = room.group_index("accent").expect("accent");
     let red = Rgb::new(0.85, 0.2, 0.1);
     let mut changed = albedo.clone();

@@ -9,13 +9,13 @@
 
 mod common;
 
-use common::{PROBE, WINDOW_ROOM, mean, relative_mse, render_with_objects};
-use glam::{Mat3, Vec3};
+use common::{PROBE, mean, relative_mse, render_with_objects, window_room};
+use glam::Vec3;
 use ibl_core::{Image, LatLong, Rgb};
 use ibl_room::room_radiance::RoomRadiance;
 use ibl_room::{
-    AnalysisSettings, DisplayMode, ObjectDisplay, ObjectDisplaySettings, Room, RoomDescription,
-    RoomVolume, VolumeSettings, analyse_room, important_patches,
+    AnalysisSettings, DisplayMode, ObjectDisplay, ObjectDisplaySettings, RoomVolume,
+    VolumeSettings, analyse_room, important_patches,
 };
 use ibl_scene::{GeometryLayer, Material, PlacedMesh};
 
@@ -59,13 +59,7 @@ struct Validation {
 }
 
 fn validate(material: Material, width: u32, spp: u32) -> Validation {
-    let description: RoomDescription = toml::from_str(WINDOW_ROOM).expect("room parses");
-    let room = Room::new(&description, PROBE, Mat3::IDENTITY).expect("room");
-    let albedo: Vec<Rgb> = room
-        .groups
-        .iter()
-        .map(|g| g.measured_reflectance.unwrap_or(Rgb::ZERO))
-        .collect();
+    let (room, _, albedo) = window_room();
     let objects = sphere(material);
     let halves = render_with_objects(&room, &albedo, &[], &objects, PROBE, width, spp);
     let with_halves = [

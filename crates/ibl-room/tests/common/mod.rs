@@ -45,6 +45,20 @@ pub const SKY: Rgb = Rgb::new(9.0, 9.5, 10.0);
 pub const PROBE: Vec3 = Vec3::new(-0.6, 1.2, 0.6);
 pub const SIDE_VIEW: Vec3 = Vec3::new(1.75, 1.0, 0.4);
 
+/// The window room placed for the probe and for the side view, and each group's albedo (its
+/// `measured_reflectance`; 0 for the window).
+pub fn window_room() -> (Room, Room, Vec<Rgb>) {
+    let description: ibl_room::RoomDescription = toml::from_str(WINDOW_ROOM).expect("room parses");
+    let room = Room::new(&description, PROBE, Mat3::IDENTITY).expect("room");
+    let side = Room::new(&description, SIDE_VIEW, Mat3::IDENTITY).expect("room");
+    let albedo = room
+        .groups
+        .iter()
+        .map(|g| g.measured_reflectance.unwrap_or(Rgb::ZERO))
+        .collect();
+    (room, side, albedo)
+}
+
 /// Two path-traced panoramas of `room` with `albedo` per surface group and the point lights
 /// `luminaires`, from `position` (seeds 1 and 2, `spp / 2` each; the window open to the sky).
 pub fn render_halves(
