@@ -6,7 +6,7 @@
 //! of the same face) and new goniometric lights (section 4.2: IES LM-63 or EULUMDAT files placed
 //! and turned in the room, EQ5 per point with shadow rays, their light bounced like a material
 //! change's) and virtual objects (section 4.1: the fast or improved display, their shadows
-//! subtracted from the probe; not yet with lights or a view). Without a `[view]`, the output is
+//! subtracted from the probe, lit by the new lights too). Without a `[view]`, the output is
 //! the edited probe (lat-long); with one,
 //! the view from the moved camera. `--before` writes the same picture without the edits, at the
 //! same exposure, for side-by-side comparison.
@@ -360,13 +360,6 @@ impl RoomEdits {
                 "{} objects (at most {MAX_OBJECTS})",
                 file.object.len()
             )));
-        }
-        if !file.object.is_empty() && (!lights.is_empty() || view.is_some()) {
-            return Err(bad(
-                "virtual objects are displayed in the probe's panorama with material changes; \
-                 with [[light]] or a [view] they are not supported yet (docs/ROOMS.md section 13)"
-                    .into(),
-            ));
         }
         let display = match file.display.as_str() {
             "improved" => DisplayMode::Improved,
@@ -811,27 +804,36 @@ pub fn render_edits(
     let seconds_edit = start.elapsed().as_secs_f64();
 
     let start = Instant::now();
+    // The edited room as a radiance field: the edited probe's texture, the edited estimate, the
+    // new lights' light (what a moved camera and the objects' volume see).
+    let estimate = edited_estimate(estimated, &edit.radiosity);
+    let field = RoomRadiance::new(room, &analysis.depth, &edited_probe, &estimate)?;
+    let field = match &addition {
+        Some(a) => field.with_added_light(a),
+        None => field,
+    };
+    let lamps: Vec<GoniometricLight> = lights.iter().map(|l| l.light.clone()).collect();
+    let objects = assets.objects.as_ref().map(|objects| ObjectInputs {
+        field: &field,
+        estimate: &estimate,
+        reflectance: &edit.reflectance,
+        objects,
+        lamps: &lamps,
+        edits,
+    });
     let (before, after, filled_fraction) = match &edits.view {
         None => {
-            let after = match (&addition, &assets.objects) {
-                (Some(a), _) => a.panorama(room, &analysis.depth, &edited_probe)?,
-                (None, Some(objects)) => {
-                    let estimate = edited_estimate(estimated, &edit.radiosity);
-                    display_objects(
-                        estimated,
-                        &estimate,
-                        &edited_probe,
-                        &edit.reflectance,
-                        objects,
-                        edits,
-                    )?
-                }
-                (None, None) => edited_probe,
+            let lit = match &addition {
+                Some(a) => a.panorama(room, &analysis.depth, &edited_probe)?,
+                None => edited_probe.clone(),
+            };
+            let after = match &objects {
+                Some(o) => o.display(|d| Ok(d.panorama(&lit)?.image))?,
+                None => lit,
             };
             (estimated.probe.clone(), after, None)
         }
         Some(view) => {
-            let edited_estimate = edited_estimate(estimated, &edit.radiosity);
             let texture = if view.textured {
                 Some(FillTexture::new(
                     room,
@@ -850,9 +852,9 @@ pub fn render_edits(
             let settings = NovelViewSettings {
                 samples_per_axis: view.samples_per_axis,
             };
-            let render = |field: RoomRadiance| -> Result<ibl_room::NovelView> {
+            let render = |field: &RoomRadiance| -> Result<ibl_room::NovelView> {
                 Ok(render_novel_view(
-                    &field,
+                    field,
                     &camera,
                     view.width,
                     view.height,
@@ -860,21 +862,24 @@ pub fn render_edits(
                     &settings,
                 )?)
             };
-            let before = render(RoomRadiance::new(
+            let before = render(&RoomRadiance::new(
                 room,
                 &analysis.depth,
                 &estimated.probe,
                 &analysis.estimate,
             )?)?;
-            let field = RoomRadiance::new(room, &analysis.depth, &edited_probe, &edited_estimate)?;
-            let after = render(match &addition {
-                Some(a) => field.with_added_light(a),
-                None => field,
-            })?;
-            let filled = after.filled_mask();
+            let after = match &objects {
+                Some(o) => {
+                    o.display(|d| Ok(d.view(&camera, view.width, view.height, fill)?.image))?
+                }
+                None => render(&field)?.image,
+            };
+            // Which pixels show only surfaces the probe did not see depends on the room and the
+            // camera alone: the same before and after the edits.
+            let filled = before.filled_mask();
             let n = filled.pixels().iter().filter(|&&f| f).count();
             let fraction = n as f64 / filled.pixels().len().max(1) as f64;
-            (before.image, after.image, Some(fraction))
+            (before.image, after, Some(fraction))
         }
     };
     let last_bounce_relative = edit
@@ -911,26 +916,39 @@ fn edited_estimate(estimated: &EstimatedRoom, radiosity: &[Rgb]) -> ibl_room::Es
     estimate
 }
 
-/// The objects composited into `probe` (the edited probe, its room as `estimate` has it): the
-/// important patches, the irradiance volume of the edited room, Grosch's display.
-fn display_objects(
-    estimated: &EstimatedRoom,
-    estimate: &ibl_room::Estimate,
-    probe: &Image<Rgb>,
-    reflectance: &[Rgb],
-    objects: &GeometryLayer,
-    edits: &RoomEdits,
-) -> Result<Image<Rgb>> {
-    let room = &estimated.input.room;
-    let field = RoomRadiance::new(room, &estimated.analysis.depth, probe, estimate)?;
-    let important = important_patches(room, estimate, edits.important_patches);
-    let volume: RoomVolume = RoomVolume::build(&field, &important, &VolumeSettings::default())?;
-    let settings = ObjectDisplaySettings {
-        mode: edits.display,
-        ..ObjectDisplaySettings::default()
-    };
-    let display = ObjectDisplay::new(&field, &volume, &important, reflectance, objects, settings)?;
-    Ok(display.panorama(probe)?.image)
+/// What the objects' display needs of the edited room.
+struct ObjectInputs<'a> {
+    field: &'a RoomRadiance<'a>,
+    estimate: &'a ibl_room::Estimate,
+    reflectance: &'a [Rgb],
+    objects: &'a GeometryLayer,
+    lamps: &'a [GoniometricLight],
+    edits: &'a RoomEdits,
+}
+
+impl ObjectInputs<'_> {
+    /// Builds the display (the important patches, the irradiance volume of the edited room,
+    /// Grosch's display with the new lights) and hands it to `picture`.
+    fn display<R>(&self, picture: impl FnOnce(&ObjectDisplay) -> Result<R>) -> Result<R> {
+        let room = self.field.room();
+        let important = important_patches(room, self.estimate, self.edits.important_patches);
+        let volume: RoomVolume =
+            RoomVolume::build(self.field, &important, &VolumeSettings::default())?;
+        let settings = ObjectDisplaySettings {
+            mode: self.edits.display,
+            ..ObjectDisplaySettings::default()
+        };
+        let display = ObjectDisplay::new(
+            self.field,
+            &volume,
+            &important,
+            self.reflectance,
+            self.objects,
+            settings,
+        )?
+        .with_lamps(self.lamps);
+        picture(&display)
+    }
 }
 
 /// The room's group index of each edited group, in the edits' order; an error naming the room's

@@ -271,16 +271,6 @@ fn the_apartment_gets_the_bunny_and_its_shadow() {
             );
         }
     }
-    // Objects with lights or a moved camera are refused for now, naming the file.
-    let text = "version = 1\n[[object]]\nshape = \"sphere\"\nradius = 0.2\n\
-                [[light]]\nfile = \"a.ies\"\nposition = [0, 2, 0]\n";
-    let e = RoomEdits::parse(text, Path::new("e.toml"))
-        .unwrap_err()
-        .to_string();
-    assert!(
-        e.contains("e.toml") && e.contains("not supported yet"),
-        "{e}"
-    );
     let e = RoomEdits::parse("version = 1\ndisplay = \"best\"\n", Path::new("e.toml"))
         .unwrap_err()
         .to_string();
@@ -293,4 +283,58 @@ fn the_apartment_gets_the_bunny_and_its_shadow() {
     .unwrap();
     let e = bad.load().unwrap_err().to_string();
     assert!(e.contains("object[0]") && e.contains("radius"), "{e}");
+}
+
+#[test]
+fn the_bunny_under_a_new_light_from_a_moved_camera() {
+    let room = apartment().join("room.toml");
+    let estimated = estimate_room(&room, &SamplingOptions::default(), &Silent).unwrap();
+    // The bunny of edits-object.toml seen from 1.3 m away, with and without a downlight 1.4 m
+    // above it.
+    let bunny = "[[object]]\nshape = \"mesh\"\nfile = \"../../models/bunny.glb\"\nscale = 0.25\n\
+                 rotate_deg = [-60.0, 0.0, 0.0]\ntranslate = [1.45, 0.223, -0.75]\n\
+                 material = { kind = \"diffuse\", albedo = [0.75, 0.75, 0.75] }\n";
+    let light = "[[light]]\nfile = \"../../photometry/ies/umbrella.ies\"\n\
+                 position = [1.45, 1.6, -0.75]\npeak_intensity = 20.0\n";
+    let view = "[view]\nposition = [0.6, 1.0, 0.1]\nlook_at = [1.45, 0.25, -0.75]\n\
+                vertical_fov_deg = 40.0\nsize = [96, 72]\nfill = \"estimate\"\n\
+                samples_per_axis = 1\n";
+    let render = |parts: &[&str]| {
+        let text = format!("version = 1\n{}", parts.concat());
+        let edits = RoomEdits::parse(&text, &apartment().join("e.toml")).unwrap();
+        let assets = edits.load().unwrap();
+        render_edits(&estimated, &edits, &assets, &room).unwrap()
+    };
+    let (plain, dark, lit) = (
+        render(&[view]),
+        render(&[bunny, view]),
+        render(&[bunny, light, view]),
+    );
+    assert_eq!((lit.after.width(), lit.after.height()), (96, 72));
+    assert!(plain.objects.is_none() && lit.objects.is_some());
+    // The view's centre shows the bunny instead of the floor, and the light above it makes it
+    // brighter there.
+    let centre = |image: &Image<Rgb>| {
+        let mut sum = 0.0f32;
+        for y in 30..42 {
+            for x in 42..54 {
+                sum += image.get(x, y).g;
+            }
+        }
+        sum / 144.0
+    };
+    let (p, d, l) = (
+        centre(&plain.after),
+        centre(&dark.after),
+        centre(&lit.after),
+    );
+    eprintln!("view centre: floor {p:.3}, bunny {d:.3}, bunny under the light {l:.3}");
+    assert!(
+        (d - p).abs() > 0.05 * p,
+        "the bunny {d} against the floor {p}"
+    );
+    assert!(
+        l > 1.5 * d,
+        "the bunny lit {l} against {d} without the light"
+    );
 }

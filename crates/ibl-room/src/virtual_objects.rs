@@ -36,6 +36,12 @@
 //! this takes the relative MSE over the sphere and its neighbourhood from the fast display's 6.7 %
 //! to 0.72 % (`docs/ROOMS.md` section 13).
 //!
+//! **New lights** ([`ObjectDisplay::with_lamps`], section 4.2) light the objects by EQ5 through
+//! shadow rays (the room and the objects block them), and the objects' shadow of their light is
+//! subtracted from the room like the important patches'; their light on the room comes with the
+//! room's radiance field ([`RoomRadiance::with_added_light`]), and so does its bounce in the
+//! volume.
+//!
 //! **Mirrors** reflect the room: a mirror's radiance is its reflectance times the room's radiance
 //! along the reflected ray ([`RoomRadiance`], the probe's texture where it saw; the paper's
 //! floating-point reflection map), less the objects' shadow where that ray lands (a mirror sphere
@@ -50,16 +56,21 @@
 //!
 //! **The picture** is the probe re-rendered from its own centre ([`ObjectDisplay::panorama`]),
 //! `n x n` rays per pixel: a ray that meets an object first takes the object's radiance, one that
-//! meets the room takes the probe pixel's radiance minus the objects' shadow at its point.
+//! meets the room takes the probe pixel's radiance minus the objects' shadow at its point. From a
+//! moved camera ([`ObjectDisplay::view`], section 4.4) a ray that meets the room takes the room's
+//! radiance field there instead (the probe's texture where it saw, the fill where it did not),
+//! minus the same shadow.
 //! World frame, metres; radiance in the probe's units.
 
 use glam::Vec3;
 use ibl_core::{Image, LatLong, Rgb};
-use ibl_scene::{GeometryLayer, Material, Ray, SurfacePoint};
+use ibl_light::GoniometricLight;
+use ibl_scene::{Camera, GeometryLayer, Material, Ray, SurfacePoint};
 use ibl_sh::{LeakControl, VolumeLayer};
 
 use crate::important::ImportantLights;
 use crate::irradiance_volume::{KeyPointVisibility, RoomVolume};
+use crate::novel_view::{HoleFill, MAX_VIEW_PIXELS};
 use crate::room_radiance::RoomRadiance;
 use crate::{Room, RoomError};
 
@@ -144,6 +155,8 @@ pub struct ObjectDisplay<'a> {
     /// A sphere around every object (centre, radius; metres): rays and segments that miss it
     /// cannot meet an object, so the room's points far from the objects cost a few tests only.
     bound: Option<(Vec3, f32)>,
+    /// New goniometric lights (section 4.2) lighting the objects, shadowed by them.
+    lamps: &'a [GoniometricLight],
 }
 
 /// Whether the segment `origin + t direction`, `0 <= t <= t_max` (unit `direction`), passes
@@ -236,7 +249,49 @@ impl<'a> ObjectDisplay<'a> {
                 .bvh
                 .bounds()
                 .map(|(min, max)| ((min + max) * 0.5, (max - min).length() * 0.5 + RAY_OFFSET_M)),
+            lamps: &[],
         })
+    }
+
+    /// The same display with the new lights `lamps` (section 4.2; the field and the volume it
+    /// was made with should carry their light on the room, [`RoomRadiance::with_added_light`]):
+    /// their direct light (EQ5) lights the objects through shadow rays, and the objects' shadow
+    /// of it is subtracted from the room.
+    pub fn with_lamps(mut self, lamps: &'a [GoniometricLight]) -> ObjectDisplay<'a> {
+        self.lamps = lamps;
+        self
+    }
+
+    /// The new lights' direct light at `x` (unit normal `n`, rays from `origin`), split into what
+    /// arrives and what only the objects block.
+    fn lamp_light(&self, x: Vec3, n: Vec3, origin: Vec3) -> ImportantLight {
+        let mut sum = ImportantLight::default();
+        for lamp in self.lamps {
+            let e = lamp.irradiance_at(x, n);
+            if e.max_channel() <= 0.0 {
+                continue;
+            }
+            let to = lamp.position - origin;
+            let distance = to.length();
+            if distance <= 2.0 * RAY_OFFSET_M {
+                continue;
+            }
+            let direction = to / distance;
+            let t_max = distance - RAY_OFFSET_M;
+            if self.room.occluded(origin, direction, 0.0, t_max) {
+                continue;
+            }
+            if self
+                .objects
+                .bvh
+                .occluded(&Ray::new(origin, direction), 0.0, t_max)
+            {
+                sum.blocked_by_objects += e;
+            } else {
+                sum.open += e;
+            }
+        }
+        sum
     }
 
     /// The important patches' light at `x` (unit normal `n`, rays from `origin` just above the
@@ -424,7 +479,7 @@ impl<'a> ObjectDisplay<'a> {
                     .map(|v| v.max(0.0))
                         + self.important_light(surface.position, n, origin).open
                 }
-            };
+            } + self.lamp_light(surface.position, n, origin).open;
             albedo * e / std::f32::consts::PI
         } else {
             Rgb::ZERO
@@ -464,7 +519,8 @@ impl<'a> ObjectDisplay<'a> {
         let origin = x + n * RAY_OFFSET_M;
         let lost = self
             .important_light_where(x, n, origin, true)
-            .blocked_by_objects;
+            .blocked_by_objects
+            + self.lamp_light(x, n, origin).blocked_by_objects;
         let loss = rho * lost / std::f32::consts::PI;
         if gather {
             loss + self.unimportant_shadow(patch, x)
@@ -484,38 +540,91 @@ impl<'a> ObjectDisplay<'a> {
         rho * change * (-1.0 / std::f32::consts::PI)
     }
 
-    /// The radiance along one ray from the probe centre (unit world `direction`) whose real
-    /// surface shows `observed` in the probe, and whether it met an object.
+    /// The radiance along one unit ray `origin + t direction`, and whether it met an object.
+    /// A ray that meets the room takes `observed` there when given (the probe pixel, for rays
+    /// from the probe's centre), else the room's radiance field at the point (textured by
+    /// `fill` where the probe did not see it, as a novel view), less the objects' shadow.
     /// `unimportant` caches, per pixel, the improved display's unimportant part of the shadow at
     /// the first real point one of its rays meets: that part is smooth (it comes from the whole
     /// cone of the objects), so the pixel's other rays reuse it; the important part, which makes
     /// the sharp edges, is evaluated at every ray's point.
-    fn probe_ray(
+    fn trace(
         &self,
+        origin: Vec3,
         direction: Vec3,
-        observed: Rgb,
+        observed: Option<Rgb>,
+        fill: HoleFill,
         unimportant: &mut Option<Rgb>,
-    ) -> (Rgb, bool) {
-        let origin = self.room.probe_position;
+    ) -> Option<(Rgb, bool)> {
         let real = self.room.hit(origin, direction, 0.0, f32::INFINITY);
         let limit = real.map_or(f32::INFINITY, |h| h.distance_m);
         let ray = Ray::new(origin, direction);
         if let Some(hit) = self.objects.bvh.closest_hit(&ray, 0.0, limit) {
             let surface = self.objects.surface_point(&hit, direction);
-            return (self.object_radiance(&surface, -direction), true);
+            return Some((self.object_radiance(&surface, -direction), true));
         }
-        match real {
-            Some(h) if h.front => {
-                let x = origin + direction * h.distance_m;
-                let patch = h.patch as usize;
-                let mut loss = self.shadow_loss(patch, x, false);
-                if self.settings.mode == DisplayMode::Improved {
-                    loss += *unimportant.get_or_insert_with(|| self.unimportant_shadow(patch, x));
+        let h = real.filter(|h| h.front)?;
+        let x = origin + direction * h.distance_m;
+        let patch = h.patch as usize;
+        let radiance = match observed {
+            Some(l) => l,
+            None => {
+                let (l, seen) = self.radiance.at(x, patch);
+                match (seen, fill) {
+                    (false, HoleFill::Textured(texture)) => {
+                        l * texture.modulation(self.room.patches[patch].face as usize, x)
+                    }
+                    _ => l,
                 }
-                ((observed - loss).map(|v| v.max(0.0)), false)
             }
-            _ => (observed, false),
+        };
+        let mut loss = self.shadow_loss(patch, x, false);
+        if self.settings.mode == DisplayMode::Improved {
+            loss += *unimportant.get_or_insert_with(|| self.unimportant_shadow(patch, x));
         }
+        Some(((radiance - loss).map(|v| v.max(0.0)), false))
+    }
+
+    /// The room with the objects through `camera` (a moved camera of section 4.4, or any
+    /// camera inside the room) at `width x height`, `samples_per_axis^2` rays per pixel; the
+    /// surfaces the probe did not see filled by `fill`, rays that meet nothing black.
+    pub fn view(
+        &self,
+        camera: &Camera,
+        width: u32,
+        height: u32,
+        fill: HoleFill,
+    ) -> Result<ObjectPicture, RoomError> {
+        let (w, h) = (width as usize, height as usize);
+        if w == 0 || h == 0 || w.saturating_mul(h) > MAX_VIEW_PIXELS {
+            return Err(RoomError::Parameter(format!(
+                "a {width} x {height} view is empty or more than {MAX_VIEW_PIXELS} pixels"
+            )));
+        }
+        let n = self.settings.samples_per_axis;
+        let pixels = Image::from_fn_par(w, h, |i, j| {
+            let (mut sum, mut hits) = (Rgb::ZERO, 0u32);
+            let mut unimportant = None;
+            for b in 0..n {
+                for a in 0..n {
+                    let x = i as f32 + (a as f32 + 0.5) / n as f32;
+                    let y = j as f32 + (b as f32 + 0.5) / n as f32;
+                    let ray = camera.ray(x, y, width, height);
+                    if let Some((l, object)) =
+                        self.trace(ray.origin, ray.direction, None, fill, &mut unimportant)
+                    {
+                        sum += l;
+                        hits += u32::from(object);
+                    }
+                }
+            }
+            let k = (n * n) as f32;
+            (sum / k, hits as f32 / k)
+        });
+        Ok(ObjectPicture {
+            image: pixels.map(|p| p.0),
+            coverage: pixels.map(|p| p.1),
+        })
     }
 
     /// The probe (`probe`, lat-long, its pixels the room as the probe saw it) re-rendered with
@@ -535,7 +644,15 @@ impl<'a> ObjectDisplay<'a> {
                     let u = (i as f64 + (f64::from(a) + 0.5) / f64::from(n)) / w as f64;
                     let v = (j as f64 + (f64::from(b) + 0.5) / f64::from(n)) / h as f64;
                     let d = self.room.world_from_probe * LatLong::uv_to_dir(u, v);
-                    let (l, object) = self.probe_ray(d.normalize(), observed, &mut unimportant);
+                    let (l, object) = self
+                        .trace(
+                            self.room.probe_position,
+                            d.normalize(),
+                            Some(observed),
+                            HoleFill::Estimate,
+                            &mut unimportant,
+                        )
+                        .unwrap_or((observed, false));
                     sum += l;
                     hits += u32::from(object);
                 }
