@@ -30,21 +30,21 @@ enum RoomCommand {
     /// The room's N important light patches as an area-light file for `ibl render --lights`.
     Lights(LightsArgs),
     /// The room re-rendered after material changes (with colour bleeding), with new IES/LDT
-    /// lights, or from a moved camera.
+    /// lights and virtual objects, or from a moved camera.
     Render(RenderArgs),
 }
 
 /// Arguments of `ibl room render`.
 #[derive(Args)]
 #[command(after_help = "\
-The edits file (docs/ROOMS.md sections 11 and 12): [[material]] changes with bounces of colour
-bleeding, [[light]] goniometric lights (IES LM-63 or EULUMDAT files, placed and turned, with
-shadows and bounced light), and a [view] from a moved camera (else the edited probe is the output).
+The edits file (docs/ROOMS.md sections 11 to 13): [[material]] changes with colour bleeding,
+[[light]] IES/EULUMDAT lights with shadows and bounced light, [[object]] virtual objects (display =
+\"improved\" or \"fast\"), and a [view] from a moved camera (else the edited probe is the output).
 
 Examples:
   ibl room render assets/rooms/apartment/room.toml --edit assets/rooms/apartment/edits.toml -o a.png --before b.png
   ibl room render assets/rooms/apartment/room.toml --edit assets/rooms/apartment/edits-light.toml -o lit.png
-  ibl room render room.toml --edit edits.toml -o view.exr --json")]
+  ibl room render assets/rooms/apartment/room.toml --edit assets/rooms/apartment/edits-object.toml -o bunny.png --json")]
 struct RenderArgs {
     /// Room file (.toml).
     room: PathBuf,
