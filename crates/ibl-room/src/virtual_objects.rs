@@ -141,6 +141,17 @@ struct ImportantLight {
     blocked_by_objects: Rgb,
 }
 
+impl ImportantLight {
+    /// Adds `e` where [`ObjectDisplay::objects_block`] says it goes (nothing for `None`).
+    fn add(&mut self, objects_block: Option<bool>, e: Rgb) {
+        match objects_block {
+            Some(true) => self.blocked_by_objects += e,
+            Some(false) => self.open += e,
+            None => {}
+        }
+    }
+}
+
 /// The room with virtual objects, ready to be displayed.
 pub struct ObjectDisplay<'a> {
     room: &'a Room,
@@ -262,47 +273,54 @@ impl<'a> ObjectDisplay<'a> {
         self
     }
 
+    /// Whether the segment from `origin` to a light at `target` is blocked by the objects
+    /// (`Some(true)`) or open (`Some(false)`); `None` when the room blocks it or its ends are
+    /// within two offsets of each other. With `blocked_only` a segment that misses the objects'
+    /// bounding sphere is `None` untested (only the objects' part is asked for).
+    fn objects_block(&self, origin: Vec3, target: Vec3, blocked_only: bool) -> Option<bool> {
+        let to = target - origin;
+        let distance = to.length();
+        if distance <= 2.0 * RAY_OFFSET_M {
+            return None;
+        }
+        let direction = to / distance;
+        let t_max = distance - RAY_OFFSET_M;
+        let near_objects = self
+            .bound
+            .is_some_and(|b| segment_meets_sphere(origin, direction, t_max, b));
+        if blocked_only && !near_objects {
+            return None;
+        }
+        if self.room.occluded(origin, direction, 0.0, t_max) {
+            return None;
+        }
+        Some(
+            near_objects
+                && self
+                    .objects
+                    .bvh
+                    .occluded(&Ray::new(origin, direction), 0.0, t_max),
+        )
+    }
+
     /// The new lights' direct light at `x` (unit normal `n`, rays from `origin`), split into what
-    /// arrives and what only the objects block.
-    fn lamp_light(&self, x: Vec3, n: Vec3, origin: Vec3) -> ImportantLight {
+    /// arrives and what only the objects block; with `blocked_only` as [`Self::objects_block`].
+    fn lamp_light(&self, x: Vec3, n: Vec3, origin: Vec3, blocked_only: bool) -> ImportantLight {
         let mut sum = ImportantLight::default();
         for lamp in self.lamps {
             let e = lamp.irradiance_at(x, n);
             if e.max_channel() <= 0.0 {
                 continue;
             }
-            let to = lamp.position - origin;
-            let distance = to.length();
-            if distance <= 2.0 * RAY_OFFSET_M {
-                continue;
-            }
-            let direction = to / distance;
-            let t_max = distance - RAY_OFFSET_M;
-            if self.room.occluded(origin, direction, 0.0, t_max) {
-                continue;
-            }
-            if self
-                .objects
-                .bvh
-                .occluded(&Ray::new(origin, direction), 0.0, t_max)
-            {
-                sum.blocked_by_objects += e;
-            } else {
-                sum.open += e;
-            }
+            sum.add(self.objects_block(origin, lamp.position, blocked_only), e);
         }
         sum
     }
 
     /// The important patches' light at `x` (unit normal `n`, rays from `origin` just above the
-    /// surface), split into what arrives and what only the objects block.
-    fn important_light(&self, x: Vec3, n: Vec3, origin: Vec3) -> ImportantLight {
-        self.important_light_where(x, n, origin, false)
-    }
-
-    /// [`Self::important_light`]; with `blocked_only`, only the part the objects block (the light
-    /// points whose segment misses the objects' bounding sphere are skipped untested).
-    fn important_light_where(
+    /// surface), split into what arrives and what only the objects block; with `blocked_only`
+    /// as [`Self::objects_block`].
+    fn important_light(
         &self,
         x: Vec3,
         n: Vec3,
@@ -316,40 +334,14 @@ impl<'a> ObjectDisplay<'a> {
             if r2 <= 0.0 {
                 continue;
             }
-            let r = r2.sqrt();
-            let w = to / r;
+            let w = to / r2.sqrt();
             let (cos_r, cos_l) = (n.dot(w), -p.normal.dot(w));
             if cos_r <= 0.0 || cos_l <= 0.0 {
                 continue;
             }
             // dE = L (A / s^2) cos cos / max(r^2, A / s^2).
             let e = p.power * (cos_r * cos_l / r2.max(p.cell_m2));
-            let to_light = p.position - origin;
-            let distance = to_light.length();
-            if distance <= 2.0 * RAY_OFFSET_M {
-                continue;
-            }
-            let direction = to_light / distance;
-            let t_max = distance - RAY_OFFSET_M;
-            let near_objects = self
-                .bound
-                .is_some_and(|b| segment_meets_sphere(origin, direction, t_max, b));
-            if blocked_only && !near_objects {
-                continue;
-            }
-            if self.room.occluded(origin, direction, 0.0, t_max) {
-                continue;
-            }
-            if near_objects
-                && self
-                    .objects
-                    .bvh
-                    .occluded(&Ray::new(origin, direction), 0.0, t_max)
-            {
-                sum.blocked_by_objects += e;
-            } else {
-                sum.open += e;
-            }
+            sum.add(self.objects_block(origin, p.position, blocked_only), e);
         }
         sum
     }
@@ -477,9 +469,11 @@ impl<'a> ObjectDisplay<'a> {
                     (self.volume_irradiance(origin, n, VolumeLayer::UnimportantLight)
                         + self.unimportant_change(surface.position, n, origin, true))
                     .map(|v| v.max(0.0))
-                        + self.important_light(surface.position, n, origin).open
+                        + self
+                            .important_light(surface.position, n, origin, false)
+                            .open
                 }
-            } + self.lamp_light(surface.position, n, origin).open;
+            } + self.lamp_light(surface.position, n, origin, false).open;
             albedo * e / std::f32::consts::PI
         } else {
             Rgb::ZERO
@@ -517,10 +511,8 @@ impl<'a> ObjectDisplay<'a> {
         }
         let n = self.room.patches[patch].normal;
         let origin = x + n * RAY_OFFSET_M;
-        let lost = self
-            .important_light_where(x, n, origin, true)
-            .blocked_by_objects
-            + self.lamp_light(x, n, origin).blocked_by_objects;
+        let lost = self.important_light(x, n, origin, true).blocked_by_objects
+            + self.lamp_light(x, n, origin, true).blocked_by_objects;
         let loss = rho * lost / std::f32::consts::PI;
         if gather {
             loss + self.unimportant_shadow(patch, x)
