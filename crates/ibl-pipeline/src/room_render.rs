@@ -549,6 +549,20 @@ pub struct RoomRenderResult {
     pub width: usize,
     /// Output size, pixels.
     pub height: usize,
+    /// What the edits did (its fields sit beside these in the JSON).
+    #[serde(flatten)]
+    pub edit: EditReport,
+    /// Exposure of `.png`/`.jpg` outputs, stops (the before picture's automatic exposure).
+    pub exposure_stops: f32,
+    /// Seconds: the estimate (depth map, form factors, radiosity).
+    pub seconds_estimate: f64,
+    /// Files written.
+    pub outputs: Vec<String>,
+}
+
+/// What applying an edits file did: the demo's and `ibl room render --json`'s account of it.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct EditReport {
     /// The groups changed, with their reflectance before and after.
     pub materials: Vec<MaterialRow>,
     /// The lights added.
@@ -562,29 +576,23 @@ pub struct RoomRenderResult {
     pub last_bounce_relative: f32,
     /// A view's pixels whose rays all met surfaces the probe did not see (filled), fraction.
     pub filled_fraction: Option<f64>,
-    /// Exposure of `.png`/`.jpg` outputs, stops (the before picture's automatic exposure).
-    pub exposure_stops: f32,
-    /// Seconds: the estimate (depth map, form factors, radiosity), the edit, the picture(s).
-    pub seconds_estimate: f64,
     /// Seconds of the edit (the material change, the new lights' patch means, the bleeding).
     pub seconds_edit: f64,
     /// Seconds of rendering the picture(s).
     pub seconds_render: f64,
-    /// Files written.
-    pub outputs: Vec<String>,
 }
 
 impl RoomRenderResult {
     /// What `ibl room render` prints.
     pub fn text(&self) -> String {
         let mut text = format!("{} x {} {}", self.width, self.height, self.kind);
-        for m in &self.materials {
+        for m in &self.edit.materials {
             text += &format!(
                 "; {}: reflectance {:.3?} -> {:.3?}",
                 m.group, m.before, m.after
             );
         }
-        for l in &self.lights {
+        for l in &self.edit.lights {
             text += &format!(
                 "; light {} at {:.2?}: {:.0} lm{}, peak {:.0} cd = {:.3} probe units/sr",
                 l.file,
@@ -596,7 +604,7 @@ impl RoomRenderResult {
                 l.peak_intensity
             );
         }
-        if let Some(o) = &self.objects {
+        if let Some(o) = &self.edit.objects {
             text += &format!(
                 "; {} object(s) ({} triangles), the {} display with {} important patches",
                 o.names.len(),
@@ -605,15 +613,15 @@ impl RoomRenderResult {
                 o.important_patches
             );
         }
-        if !self.materials.is_empty() || !self.lights.is_empty() {
+        if !self.edit.materials.is_empty() || !self.edit.lights.is_empty() {
             text += &format!(
                 "; {} bounce{} of colour bleeding (the last changed {:.2} %)",
-                self.bounces,
-                if self.bounces == 1 { "" } else { "s" },
-                100.0 * self.last_bounce_relative
+                self.edit.bounces,
+                if self.edit.bounces == 1 { "" } else { "s" },
+                100.0 * self.edit.last_bounce_relative
             );
         }
-        if let Some(f) = self.filled_fraction {
+        if let Some(f) = self.edit.filled_fraction {
             text += &format!(
                 "; {:.1} % of the pixels filled (unseen by the probe)",
                 100.0 * f
@@ -622,8 +630,8 @@ impl RoomRenderResult {
         text += &format!(
             "\nestimate {:.2} s, edit {:.3} s, picture {:.2} s; wrote {}\n",
             self.seconds_estimate,
-            self.seconds_edit,
-            self.seconds_render,
+            self.edit.seconds_edit,
+            self.edit.seconds_render,
             self.outputs.join(", ")
         );
         text
@@ -688,7 +696,7 @@ pub fn room_render(o: &RoomRenderOptions, progress: &dyn Progress) -> Result<Roo
     let seconds_estimate = start.elapsed().as_secs_f64();
     let pictures = render_edits(&estimated, &edits, &assets, &o.room)?;
     let stops = pictures.write(&o.output, o.before.as_deref())?;
-    let after = &pictures.after;
+    let (width, height) = (pictures.after.width(), pictures.after.height());
     let written: Vec<String> = outputs.iter().map(|p| p.display().to_string()).collect();
     Ok(RoomRenderResult {
         room: o.room.display().to_string(),
@@ -697,18 +705,11 @@ pub fn room_render(o: &RoomRenderOptions, progress: &dyn Progress) -> Result<Roo
         } else {
             "panorama"
         },
-        width: after.width(),
-        height: after.height(),
-        materials: pictures.materials.clone(),
-        lights: pictures.lights.clone(),
-        objects: pictures.objects.clone(),
-        bounces: pictures.bounces,
-        last_bounce_relative: pictures.last_bounce_relative,
-        filled_fraction: pictures.filled_fraction,
+        width,
+        height,
+        edit: pictures.report,
         exposure_stops: stops,
         seconds_estimate,
-        seconds_edit: pictures.seconds_edit,
-        seconds_render: pictures.seconds_render,
         outputs: written,
     })
 }
@@ -721,22 +722,8 @@ pub struct EditedPictures {
     pub before: Image<Rgb>,
     /// With them.
     pub after: Image<Rgb>,
-    /// The groups changed.
-    pub materials: Vec<MaterialRow>,
-    /// The lights added.
-    pub lights: Vec<LightRow>,
-    /// The objects inserted, if any.
-    pub objects: Option<ObjectRow>,
-    /// Bounces of colour bleeding made.
-    pub bounces: u32,
-    /// The last bounce's relative change.
-    pub last_bounce_relative: f32,
-    /// A view's fraction of filled pixels.
-    pub filled_fraction: Option<f64>,
-    /// Seconds of the edit.
-    pub seconds_edit: f64,
-    /// Seconds of the pictures.
-    pub seconds_render: f64,
+    /// What the edits did.
+    pub report: EditReport,
 }
 
 impl EditedPictures {
@@ -888,22 +875,24 @@ pub fn render_edits(
     Ok(EditedPictures {
         before,
         after,
-        materials: rows,
-        lights: lights.iter().map(|l| l.row.clone()).collect(),
-        objects: assets.objects.as_ref().map(|o| ObjectRow {
-            names: o.object_names.clone(),
-            triangles: o.triangle_count(),
-            display: match edits.display {
-                DisplayMode::Fast => "fast",
-                DisplayMode::Improved => "improved",
-            },
-            important_patches: edits.important_patches,
-        }),
-        bounces: edit.bounces,
-        last_bounce_relative,
-        filled_fraction,
-        seconds_edit,
-        seconds_render: start.elapsed().as_secs_f64(),
+        report: EditReport {
+            materials: rows,
+            lights: lights.iter().map(|l| l.row.clone()).collect(),
+            objects: assets.objects.as_ref().map(|o| ObjectRow {
+                names: o.object_names.clone(),
+                triangles: o.triangle_count(),
+                display: match edits.display {
+                    DisplayMode::Fast => "fast",
+                    DisplayMode::Improved => "improved",
+                },
+                important_patches: edits.important_patches,
+            }),
+            bounces: edit.bounces,
+            last_bounce_relative,
+            filled_fraction,
+            seconds_edit,
+            seconds_render: start.elapsed().as_secs_f64(),
+        },
     })
 }
 

@@ -115,7 +115,7 @@ fn the_apartment_floor_turns_red_and_bleeds_onto_the_walls() {
     let rho = estimated.analysis.estimate.groups[floor]
         .reflectance
         .unwrap();
-    let new = pictures.materials[0].after;
+    let new = pictures.report.materials[0].after;
     let floor_ratio = mean_ratio(&pictures.before, &pictures.after, |i, j| {
         group_of(i, j) == Some(floor)
     });
@@ -147,7 +147,7 @@ fn the_apartment_floor_turns_red_and_bleeds_onto_the_walls() {
         "walls turn redder: {wall_ratio:?}"
     );
     eprintln!("walls after/before {wall_ratio:.3?}");
-    assert!(pictures.bounces == 1 && pictures.last_bounce_relative > 0.0);
+    assert!(pictures.report.bounces == 1 && pictures.report.last_bounce_relative > 0.0);
 
     // The moved camera shows the same change.
     let edits = RoomEdits::read(&apartment().join("edits-view.toml")).unwrap();
@@ -158,7 +158,7 @@ fn the_apartment_floor_turns_red_and_bleeds_onto_the_walls() {
         bottom[0] > 2.0 * bottom[2],
         "the floor at the view's bottom is redder: {bottom:?}"
     );
-    assert!(view.filled_fraction.is_some());
+    assert!(view.report.filled_fraction.is_some());
 }
 
 #[test]
@@ -170,7 +170,7 @@ fn the_apartment_gets_the_downlight_pool_eq5_predicts() {
     let lights = &assets.lights;
     let pictures = render_edits(&estimated, &edits, &assets, &room).unwrap();
     assert_eq!(pictures.before, estimated.probe, "before is the probe");
-    let row = &pictures.lights[0];
+    let row = &pictures.report.lights[0];
     // The table's flux is its exact integral (ibl-light), and the scale puts its peak at the
     // asked 40 probe units per sr.
     assert!((row.flux_lm - lights[0].light.table.flux()).abs() < 1e-9);
@@ -238,7 +238,7 @@ fn the_apartment_gets_the_bunny_and_its_shadow() {
     let edits = RoomEdits::read(&apartment().join("edits-object.toml")).unwrap();
     let assets = edits.load().unwrap();
     let pictures = render_edits(&estimated, &edits, &assets, &room).unwrap();
-    let row = pictures.objects.as_ref().unwrap();
+    let row = pictures.report.objects.as_ref().unwrap();
     assert_eq!(
         (row.names.clone(), row.display),
         (vec!["bunny".to_string()], "improved")
@@ -311,7 +311,7 @@ fn the_bunny_under_a_new_light_from_a_moved_camera() {
         render(&[bunny, light, view]),
     );
     assert_eq!((lit.after.width(), lit.after.height()), (96, 72));
-    assert!(plain.objects.is_none() && lit.objects.is_some());
+    assert!(plain.report.objects.is_none() && lit.report.objects.is_some());
     // The view's centre shows the bunny instead of the floor, and the light above it makes it
     // brighter there.
     let centre = |image: &Image<Rgb>| {
