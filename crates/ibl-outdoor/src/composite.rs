@@ -198,7 +198,7 @@ impl FrameCompositor {
 
 /// The sun as the renderer's light: a uniform cone of the sun's disc; `None` when the estimate
 /// has no sun (overcast) or its direction is not a unit vector.
-fn sun_light(sun: &SunLight) -> Option<DirectionalLight> {
+pub fn sun_light(sun: &SunLight) -> Option<DirectionalLight> {
     let irradiance = Rgb::from_array(sun.irradiance);
     let direction = Vec3::from_array(sun.direction);
     let positive = irradiance.max_channel() > 0.0; // false for NaN too

@@ -20,8 +20,9 @@
 //!   report, the important patches as an area-light file, the room re-rendered after material
 //!   changes and from a moved camera), on [`room_input`];
 //! - [`outdoor`]: outdoor AR under changing light (Jensen, Andersen & Madsen 2006): per-frame
-//!   sun and sky estimates, relit maps and composites of a frame sequence; [`video`]: video in
-//!   and out through ffmpeg;
+//!   sun and sky estimates, relit maps and composites of a frame sequence, played through
+//!   [`outdoor_sequence`] (which the viewer's sequence mode plays too); [`video`]: video in and
+//!   out through ffmpeg;
 //! - [`capture`]: brackets merged to HDR ([`exposure_list`]: the time files it reads);
 //!   [`capture_views`]: mirror balls and fisheye pairs;
 //! - [`batch`]: the per-probe pipeline over a folder, a glob or a list, one row per probe, as
@@ -59,6 +60,7 @@ pub mod irradiance;
 pub mod lighting_plan;
 pub mod lights;
 pub mod outdoor;
+pub mod outdoor_sequence;
 pub mod output_paths;
 pub mod prefilter;
 pub mod preview;

@@ -12,37 +12,22 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use glam::Vec3;
-use ibl_core::Image;
 use ibl_core::tonemap::{Display, auto_exposure_stops, to_srgb8};
 use ibl_io::WriteOptions;
 use ibl_outdoor::plot::{SeriesPoint, estimates_svg};
-use ibl_outdoor::{
-    Atmosphere, CameraSetup, CaptureSource, CompositeSettings, FrameCompositor, FrameResult,
-    Location, OutdoorSystem, ProbeCapture, SampleSettings, SmoothingOptions, SystemSettings,
-    Timestamp, VolumeRefresh, VolumeSettings,
-};
-use ibl_scene::description::{CivilTime, OutdoorDescription};
-use ibl_sh::VolumeGrid;
+use ibl_outdoor::{CompositeSettings, FrameCompositor, FrameResult};
 use serde::Serialize;
 
 use crate::error::{Context, PipelineError, Result};
+use crate::outdoor_sequence::{OutdoorSequence, SequenceFrame, frame_name};
 use crate::output_paths::{check_output_folder, check_output_path};
 use crate::progress::Progress;
-use crate::video::{VideoReader, VideoWriter};
+use crate::video::VideoWriter;
 
-/// Frame file extensions read from the frames folder (case-insensitive).
-pub const FRAME_EXTENSIONS: [&str; 6] = ["exr", "hdr", "pfm", "png", "jpg", "jpeg"];
-/// Most frames one run reads (a day at one frame per second is 86 400).
-pub const MAX_FRAMES: usize = 100_000;
 /// Width and height of the estimates' chart, pixels.
 const CHART_SIZE: (u32, u32) = (900, 620);
-/// Key-point directions of the irradiance volume (width of each point's lat-long).
-const VOLUME_DIRECTIONS: usize = 32;
 /// Frame rate of the output video unless asked otherwise.
 pub const DEFAULT_VIDEO_FPS: f64 = 10.0;
-/// Margin of the volume's box around the objects, metres.
-const VOLUME_MARGIN_M: f64 = 1.0;
 
 /// What `ibl outdoor` is asked to do.
 #[derive(Clone, Debug, PartialEq)]
@@ -135,90 +120,20 @@ pub struct OutdoorSummary {
 /// Runs the job: offline maps from the probe, then every frame.
 pub fn run_outdoor(job: &OutdoorJob, progress: &dyn Progress) -> Result<OutdoorSummary> {
     check_output_folder(&job.out_dir)?;
-    let scene_shown = job.scene.display().to_string();
-    let loaded = ibl_io::read_scene(&job.scene)?;
-    let outdoor = loaded.description.outdoor.clone().ok_or_else(|| {
-        PipelineError::parameter(format!(
-            "{scene_shown}: has no [outdoor] table (docs/SCENES.md): `ibl outdoor` needs the site, the probe's time, the mask and the frames"
-        ))
-    })?;
-    let base = job.scene.parent().unwrap_or(Path::new("."));
-    let source_path = base.join(&outdoor.frames.source);
     if !(job.video_fps.is_finite() && job.video_fps > 0.0 && job.video_fps <= 1000.0) {
         return Err(PipelineError::parameter(format!(
             "--video-fps {}: not in (0, 1000]",
             job.video_fps
         )));
     }
-    let (frame_files, mut reader) = if source_path.is_file() {
-        (Vec::new(), Some(VideoReader::open(&source_path)?))
-    } else {
-        (list_frames(&source_path, job.max_frames)?, None)
-    };
-    let mask_path = base.join(&outdoor.mask);
-    let mut scene_inputs = loaded.inputs.clone();
-    scene_inputs.push(source_path.clone());
-    check_outputs(job, &scene_inputs, &frame_files, &mask_path)?;
-    let location = location(&outdoor);
-    let probe_time = timestamp(&outdoor.probe_local_time()?, outdoor.utc_offset_hours)
-        .context(format!("{scene_shown}: outdoor.probe_time"))?;
-    let start_civil = outdoor.frames.start_local_time()?;
-    let start = timestamp(&start_civil, outdoor.utc_offset_hours)
-        .context(format!("{scene_shown}: outdoor.frames.start"))?;
-    let start_hour = civil_hour(&start_civil);
-    let mask = read_mask(&mask_path)?;
-    if let Some(r) = &reader {
-        let (w, h) = r.size();
-        if (w as usize, h as usize) != (mask.width(), mask.height()) {
-            return Err(PipelineError::parameter(format!(
-                "{}: {w} x {h} frames, but the mask {} is {} x {}: frames and mask must be the same size",
-                source_path.display(),
-                mask_path.display(),
-                mask.width(),
-                mask.height()
-            )));
-        }
-    }
-
-    let scene = &loaded.scene;
-    let settings = system_settings(&outdoor, scene)?;
-    // Each frame's time and whether the sun is up then: the model is for daylight, so a night
-    // frame is skipped with a note, and a sequence with no daylight frame is refused before the
-    // offline step.
-    let daylight = |index: usize| -> Result<bool> {
-        let time = start.plus_seconds(outdoor.frames.seconds_after_start(index));
-        Ok(location.sun_direction(time, settings.delta_t)?.y > 0.0)
-    };
-    // A video's length is not known before it is decoded: its frames are checked one by one.
-    let any_daylight = reader.is_some()
-        || (0..frame_files.len())
-            .try_fold(false, |any, i| Ok::<_, PipelineError>(any || daylight(i)?))?;
-    if !any_daylight {
-        return Err(PipelineError::parameter(format!(
-            "{scene_shown}: the sun is below the horizon at every frame's time, so every frame would be skipped (check outdoor.frames.start and utc_offset_hours)"
-        )));
-    }
+    let mut sequence = OutdoorSequence::open(&job.scene, job.max_frames)?;
+    check_outputs(job, &sequence.inputs(), &sequence.frame_files)?;
+    let scene = &sequence.loaded.scene;
     progress.begin("outdoor: offline maps and sample sites", 0);
     let setup_start = Instant::now();
-    let system = OutdoorSystem::new(
-        scene.real.clone(),
-        location,
-        &ProbeCapture {
-            radiance: scene.probe.radiance.clone(),
-            position: scene.probe.position,
-            world_from_probe: scene.probe.world_from_probe,
-            time: probe_time,
-            lighting: CaptureSource::Measured,
-        },
-        &CameraSetup {
-            camera: scene.camera,
-            frame_size: (mask.width(), mask.height()),
-            mask: mask.clone(),
-        },
-        settings,
-    );
+    let system = sequence.system();
     progress.end();
-    let mut system = system.context(&scene_shown)?;
+    let mut system = system?;
     let setup_seconds = setup_start.elapsed().as_secs_f64();
     let compositor = (job.composites && scene.virtual_objects.triangle_count() > 0)
         .then(|| {
@@ -242,62 +157,32 @@ pub fn run_outdoor(job: &OutdoorJob, progress: &dyn Progress) -> Result<OutdoorS
             ibl_io::create_dir_all(&job.out_dir.join(dir))?;
         }
     }
-    let total = if reader.is_some() {
-        job.max_frames.unwrap_or(0)
-    } else {
-        frame_files.len()
-    } as u64;
+    let total = sequence
+        .frame_count()
+        .unwrap_or(job.max_frames.unwrap_or(0)) as u64;
     progress.begin("outdoor: frames", total);
-    let mut frames = Vec::with_capacity(frame_files.len());
+    let mut frames = Vec::with_capacity(sequence.frame_files.len());
     let mut display: Option<WriteOptions> = None;
     let mut writer: Option<VideoWriter> = None;
     let mut skipped = Vec::new();
-    for index in 0.. {
-        if job.max_frames.is_some_and(|m| index >= m) {
-            break;
-        }
-        // The next frame: a file of the folder (read below, once it is known to be needed) or
-        // the video's next frame.
-        let (path, name, decoded) = match reader.as_mut() {
-            Some(r) => match r.next_frame()? {
-                Some(image) => (
-                    source_path.clone(),
-                    format!("frame_{index:05}"),
-                    Some(image),
-                ),
-                None => break,
-            },
-            None => match frame_files.get(index) {
-                Some(p) => (p.clone(), frame_name(p, index), None),
-                None => break,
-            },
-        };
-        let after = outdoor.frames.seconds_after_start(index);
-        let time = start.plus_seconds(after);
-        let local_time = local_time_label(&start_civil, after);
-        if !daylight(index)? {
+    while let Some(next) = sequence.next_frame()? {
+        let SequenceFrame {
+            index,
+            name,
+            file: path,
+            time,
+            local_time,
+            hour,
+            image,
+        } = next;
+        let Some(frame) = image else {
             progress.note(&format!(
                 "{} ({name}): the sun is below the horizon at {local_time}: skipped",
                 path.display()
             ));
             skipped.push(path.clone());
             continue;
-        }
-        let frame = match decoded {
-            Some(image) => image,
-            None => ibl_io::read_image(&path)?.image,
         };
-        if (frame.width(), frame.height()) != (mask.width(), mask.height()) {
-            return Err(PipelineError::parameter(format!(
-                "{}: {} x {} pixels, but the mask {} is {} x {}: frames and mask must be the same size",
-                path.display(),
-                frame.width(),
-                frame.height(),
-                mask_path.display(),
-                mask.width(),
-                mask.height()
-            )));
-        }
         let t0 = Instant::now();
         let result = system
             .process(time, &frame)
@@ -347,7 +232,6 @@ pub fn run_outdoor(job: &OutdoorJob, progress: &dyn Progress) -> Result<OutdoorS
         } else {
             None
         };
-        let hour = start_hour + after / 3600.0;
         frames.push(OutdoorFrame {
             index,
             name,
@@ -369,7 +253,7 @@ pub fn run_outdoor(job: &OutdoorJob, progress: &dyn Progress) -> Result<OutdoorS
     if frames.is_empty() {
         return Err(PipelineError::parameter(format!(
             "{}: no frame in daylight (every frame's time puts the sun below the horizon, or the video has no frame)",
-            source_path.display()
+            sequence.source.display()
         )));
     }
     let video = match writer {
@@ -387,28 +271,14 @@ pub fn run_outdoor(job: &OutdoorJob, progress: &dyn Progress) -> Result<OutdoorS
         json: PathBuf::from("estimates.json"),
         chart: PathBuf::from("estimates.svg"),
     };
-    write_tables(&summary, &job.out_dir, &scene_shown)?;
+    write_tables(&summary, &job.out_dir, &job.scene.display().to_string())?;
     Ok(summary)
-}
-
-/// The name of a frame's outputs: its file stem.
-fn frame_name(path: &Path, index: usize) -> String {
-    path.file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| format!("{index:05}"))
 }
 
 /// Checks, before any work, that no output lands on an input (the scene, what it names, the
 /// frames, the mask).
-fn check_outputs(
-    job: &OutdoorJob,
-    scene_inputs: &[PathBuf],
-    frames: &[PathBuf],
-    mask: &Path,
-) -> Result<()> {
-    let mut inputs: Vec<&Path> = vec![job.scene.as_path(), mask];
-    inputs.extend(scene_inputs.iter().map(PathBuf::as_path));
-    inputs.extend(frames.iter().map(PathBuf::as_path));
+fn check_outputs(job: &OutdoorJob, sequence_inputs: &[PathBuf], frames: &[PathBuf]) -> Result<()> {
+    let inputs: Vec<&Path> = sequence_inputs.iter().map(PathBuf::as_path).collect();
     let mut outputs: Vec<PathBuf> = ["estimates.csv", "estimates.json", "estimates.svg"]
         .iter()
         .map(|f| job.out_dir.join(f))
@@ -436,128 +306,6 @@ fn check_outputs(
         }
     }
     Ok(())
-}
-
-/// The frame files of `dir` (images with a [`FRAME_EXTENSIONS`] extension, by file name).
-fn list_frames(dir: &Path, max_frames: Option<usize>) -> Result<Vec<PathBuf>> {
-    let mut files = ibl_io::list_dir(dir)?;
-    files.retain(|p| {
-        p.extension()
-            .is_some_and(|x| FRAME_EXTENSIONS.iter().any(|e| x.eq_ignore_ascii_case(e)))
-    });
-    if files.is_empty() {
-        return Err(PipelineError::parameter(format!(
-            "{}: no frames (images ending in .{})",
-            dir.display(),
-            FRAME_EXTENSIONS.join(", .")
-        )));
-    }
-    if files.len() > MAX_FRAMES {
-        return Err(PipelineError::parameter(format!(
-            "{}: {} frames, more than {MAX_FRAMES} in one run",
-            dir.display(),
-            files.len()
-        )));
-    }
-    files.truncate(max_frames.unwrap_or(usize::MAX).max(1));
-    Ok(files)
-}
-
-/// The mask image: every pixel with a non-zero channel is marked.
-fn read_mask(path: &Path) -> Result<Image<bool>> {
-    let image = ibl_io::read_image(path)?.image;
-    let mask = image.map(|p| p.max_channel() > 0.0);
-    if !mask.pixels().iter().any(|&m| m) {
-        return Err(PipelineError::parameter(format!(
-            "{}: the mask marks no pixel (non-black pixels are the diffuse surfaces the estimation samples)",
-            path.display()
-        )));
-    }
-    Ok(mask)
-}
-
-/// The site of the `[outdoor]` table.
-fn location(outdoor: &OutdoorDescription) -> Location {
-    Location {
-        elevation_m: outdoor.elevation_m,
-        utc_offset_hours: outdoor.utc_offset_hours,
-        north: outdoor.north_unit(),
-        atmosphere: Atmosphere {
-            pressure_mbar: outdoor.pressure_mbar,
-            temperature_c: outdoor.temperature_c,
-        },
-        ..Location::new(outdoor.latitude_deg, outdoor.longitude_deg)
-    }
-}
-
-/// The instant of a local civil time at `utc_offset_hours`.
-fn timestamp(civil: &CivilTime, utc_offset_hours: f64) -> Result<Timestamp> {
-    let &(year, month, day, hour, minute, second) = civil;
-    Ok(Timestamp::from_local(
-        year,
-        month,
-        day,
-        hour,
-        minute,
-        second,
-        utc_offset_hours,
-    )?)
-}
-
-/// Hours since local midnight.
-fn civil_hour(civil: &CivilTime) -> f64 {
-    let &(_, _, _, hour, minute, second) = civil;
-    f64::from(hour) + f64::from(minute) / 60.0 + second / 3600.0
-}
-
-/// `YYYY-MM-DDTHH:MM:SS` of `seconds` after `start` (whole days roll over the date's day only
-/// for the label; the instant itself comes from [`Timestamp`]).
-fn local_time_label(start: &CivilTime, seconds: f64) -> String {
-    let &(year, month, day, ..) = start;
-    let total = (civil_hour(start) * 3600.0 + seconds).round() as i64;
-    let (days, rest) = (total.div_euclid(86_400), total.rem_euclid(86_400));
-    format!(
-        "{year:04}-{month:02}-{:02}T{:02}:{:02}:{:02}",
-        i64::from(day) + days,
-        rest / 3600,
-        rest / 60 % 60,
-        rest % 60
-    )
-}
-
-/// The system's settings from the `[outdoor]` table: the sample count, smoothing, and a volume
-/// over the objects when `volume_spacing_m` is given.
-fn system_settings(
-    outdoor: &OutdoorDescription,
-    scene: &ibl_scene::Scene,
-) -> Result<SystemSettings> {
-    let volume = match outdoor.volume_spacing_m {
-        Some(spacing) => {
-            let (lo, hi) = scene
-                .virtual_objects
-                .bvh
-                .bounds()
-                .unwrap_or((scene.probe.position, scene.probe.position));
-            let margin = Vec3::splat(VOLUME_MARGIN_M as f32);
-            let grid =
-                VolumeGrid::covering((lo - margin).as_dvec3(), (hi + margin).as_dvec3(), spacing)?;
-            Some(VolumeSettings {
-                grid,
-                directions_width: VOLUME_DIRECTIONS,
-                refresh: VolumeRefresh::KeyPoints,
-            })
-        }
-        None => None,
-    };
-    Ok(SystemSettings {
-        samples: SampleSettings {
-            count: outdoor.samples as usize,
-            ..SampleSettings::default()
-        },
-        smoothing: outdoor.smoothing.then(SmoothingOptions::default),
-        volume,
-        ..SystemSettings::default()
-    })
 }
 
 /// A CSV field: quoted (with inner quotes doubled) when it holds a comma, a quote or a line break.

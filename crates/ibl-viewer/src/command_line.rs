@@ -65,6 +65,8 @@ Examples:
   ibl view assets/scenes/bunny-sky.toml --headless --bench --frames 120
   ibl view probe.exr --headless --flat --method lightgen -n 32 -o lights.png
   ibl view scene.toml --screenshot window.png           open the window, save it with its UI, quit
+  ibl view assets/outdoor/courtyard/scene.toml          play an outdoor sequence: sun and sky per frame
+  ibl view assets/outdoor/courtyard/scene.toml --headless --bench --frames 24 --json
   ibl view probe.exr --marks marks.json --room room.toml  marked lines and the room over the probe
   ibl view probe.exr --marks marks.json --headless --yaw 30 --fov 100 -o shot.png
 
@@ -72,6 +74,11 @@ In the window: left-drag turns the camera (or moves the object under the cursor)
 turns the object, Ctrl-drag scales it, right-drag pans, the wheel zooms; F12 saves the frame as
 EXR and PNG, Ctrl+S saves the scene, F11 toggles full screen; drop a probe or scene file onto the
 window to open it. -o FRAME writes FRAME and FRAME's .exr (or .png) twin.
+
+A scene with an [outdoor] table (docs/OUTDOOR.md) is played as a sequence: each frame's sun
+and sky are estimated as `ibl outdoor` does, and the frame, the sun (with its shadow) and the
+ambient are drawn live; the Sequence section plays, pauses and steps, and shows the estimates,
+their chart and the relit map. Headless, --frames K plays K sequence frames.
 
 Room tools (probe; docs/ROOMS.md): marked lines are drawn x red, y green, z blue, the room's
 edges white. In the window's Room section, M switches marking on: a left-drag draws a line

@@ -22,7 +22,8 @@ use crate::probe_model::{ProbeModel, ProbeViewSettings};
 use crate::probe_renderer::ProbeRenderer;
 use crate::room_overlay::{OverlayView, RoomOverlay};
 use crate::scene_model::SceneModel;
-use crate::scene_renderer::{GlossySource, SceneFrameSettings, SceneRenderer};
+use crate::scene_renderer::{FrameReport, GlossySource, SceneFrameSettings, SceneRenderer};
+use crate::sequence_player::{PlayedFrame, SequencePlayer};
 use crate::timing::{PassTimes, median_p95};
 use crate::view_camera::{OrbitControl, OutputCamera};
 
@@ -34,6 +35,8 @@ pub enum Motion {
     Still,
     /// The camera orbits and the first object moves (the benchmark).
     Orbit,
+    /// An outdoor sequence plays, one frame of it per frame, the camera fixed (its own).
+    Sequence,
 }
 
 /// How to render headless.
@@ -126,6 +129,10 @@ pub struct HeadlessRun {
     /// Statistics over the frames (the first excluded when there are more than one: it uploads
     /// and draws what the others reuse).
     pub statistics: RunStatistics,
+    /// The sequence frames played, in order (a sequence only).
+    pub played: Vec<PlayedFrame>,
+    /// Seconds of the sequence's offline step (a sequence only).
+    pub setup_seconds: Option<f64>,
 }
 
 fn statistics(frames: &[FrameTiming]) -> RunStatistics {
@@ -182,6 +189,26 @@ fn finish(gpu: &GpuContext) -> Result<(), ViewerError> {
     gpu.take_errors()
 }
 
+/// A scene frame's timing once the GPU has finished it (its pass times read); `cpu_before` is
+/// CPU work before the frame was recorded (a sequence frame's reading and estimation).
+fn scene_frame_timing(
+    gpu: &GpuContext,
+    renderer: &mut SceneRenderer,
+    report: &FrameReport,
+    cpu_before: f64,
+    wall_seconds: f64,
+) -> FrameTiming {
+    let passes = renderer.read_pass_times(gpu, true);
+    FrameTiming {
+        cpu_seconds: cpu_before + report.cpu_seconds,
+        gpu_seconds: passes.as_ref().map(PassTimes::total),
+        wall_seconds,
+        passes,
+        drew_real_shadows: report.drew_real_shadows,
+        drew_virtual_shadows: report.drew_virtual_shadows,
+    }
+}
+
 /// Makes the scene's lights now (the headless path waits for them; the window does not).
 pub fn lights_now(model: &SceneModel) -> Result<(SceneLighting, f64), ViewerError> {
     let started = Instant::now();
@@ -220,7 +247,7 @@ pub fn render_scene(
     for k in 0..frames {
         let camera = match options.motion {
             Motion::Still => start,
-            Motion::Orbit => {
+            Motion::Orbit | Motion::Sequence => {
                 let phase = std::f32::consts::TAU * k as f32 / frames as f32;
                 let mut o = orbit;
                 o.turn(phase, 0.0);
@@ -245,15 +272,13 @@ pub fn render_scene(
         let report = renderer.render(gpu, &moving, &settings);
         finish(gpu)?;
         let wall_seconds = started.elapsed().as_secs_f64();
-        let passes = renderer.read_pass_times(gpu, true);
-        timings.push(FrameTiming {
-            cpu_seconds: report.cpu_seconds,
-            gpu_seconds: passes.as_ref().map(PassTimes::total),
+        timings.push(scene_frame_timing(
+            gpu,
+            &mut renderer,
+            &report,
+            0.0,
             wall_seconds,
-            passes,
-            drew_real_shadows: report.drew_real_shadows,
-            drew_virtual_shadows: report.drew_virtual_shadows,
-        });
+        ));
         progress(k + 1, frames);
     }
     let images = renderer.targets().read_back(gpu)?;
@@ -266,6 +291,81 @@ pub fn render_scene(
         lighting: summary,
         lighting_seconds,
         shadow_tile: renderer.shadow_tile(),
+        played: Vec::new(),
+        setup_seconds: None,
+    })
+}
+
+/// Plays `options.frames` frames of an outdoor sequence offscreen (from its first frame, again
+/// from the first after the last), each frame one sequence frame: read, estimated, relit and
+/// drawn with the scene's camera; `progress(done, total)` after each. A frame's wall time counts
+/// all of it, from reading the frame to the GPU's end.
+pub fn render_sequence(
+    gpu: &GpuContext,
+    model: &SceneModel,
+    player: &mut SequencePlayer,
+    options: &HeadlessOptions,
+    progress: &dyn Fn(usize, usize),
+) -> Result<HeadlessRun, ViewerError> {
+    let (w, h) = options.size;
+    let mut renderer = SceneRenderer::new(gpu, model, w, h, options.shadow_tile)?;
+    let display = options.display.unwrap_or(Display {
+        exposure_stops: auto_exposure(model),
+        ..Display::default()
+    });
+    let reflects = model.reflects_environment();
+    let settings = SceneFrameSettings {
+        camera: scene_camera(model, w, h),
+        display,
+        glossy: options.glossy,
+        background_rays: options.background_rays,
+        shadow_tile: options.shadow_tile,
+        selected: None,
+    };
+    let frames = options.frames.max(1) as usize;
+    let mut timings = Vec::with_capacity(frames);
+    let mut played = Vec::with_capacity(frames);
+    let mut summary = String::new();
+    let mut lighting_seconds = 0.0;
+    for k in 0..frames {
+        let started = Instant::now();
+        let step = player.step()?;
+        summary = step.lighting.summary.clone();
+        let cpu_started = Instant::now();
+        renderer.set_photo(gpu, model, step.image);
+        renderer.set_lighting(gpu, step.lighting);
+        if reflects {
+            renderer.set_environment(gpu, player.relit_map());
+        }
+        let upload_seconds = cpu_started.elapsed().as_secs_f64();
+        let report = renderer.render(gpu, model, &settings);
+        finish(gpu)?;
+        let wall_seconds = started.elapsed().as_secs_f64();
+        let f = &step.frame;
+        lighting_seconds += f.lighting_seconds;
+        let before = f.read_seconds + f.estimate_seconds + f.lighting_seconds + upload_seconds;
+        timings.push(scene_frame_timing(
+            gpu,
+            &mut renderer,
+            &report,
+            before,
+            wall_seconds,
+        ));
+        played.push(step.frame);
+        progress(k + 1, frames);
+    }
+    let images = renderer.targets().read_back(gpu)?;
+    Ok(HeadlessRun {
+        images,
+        statistics: statistics(&timings),
+        frames: timings,
+        adapter: gpu.summary.clone(),
+        lights: renderer.lighting().map_or(0, |l| l.lights.len()),
+        lighting: summary,
+        lighting_seconds: lighting_seconds / frames as f64,
+        shadow_tile: renderer.shadow_tile(),
+        played,
+        setup_seconds: Some(player.setup_seconds),
     })
 }
 
@@ -362,5 +462,7 @@ pub fn render_probe_with(
         lighting,
         lighting_seconds,
         shadow_tile: 0,
+        played: Vec::new(),
+        setup_seconds: None,
     })
 }

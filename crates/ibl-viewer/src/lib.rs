@@ -15,6 +15,8 @@
 //!   view (Grosch 2005 section 3.1); [`room_marking`]: the marks being edited in the window
 //!   (adding lines, calibrating, saving).
 //! - [`light_space`]: orthographic shadow projections and the atlas layout.
+//! - [`sequence_player`]: an outdoor scene's frames played through the library's per-frame sun
+//!   and sky estimation (Jensen, Andersen & Madsen 2006), as lights, ambient and background.
 //!
 //! GPU:
 //! - [`gpu`]: the device; [`textures`]: radiance uploads; [`frame_targets`]: what a frame is drawn
@@ -27,7 +29,8 @@
 //!   pipeline both overlay passes share.
 //! - [`scene_renderer`], [`probe_renderer`]: one frame each; [`timing`]: GPU pass timestamps.
 //! - [`headless`]: offscreen frames and the benchmark; [`window`]: the eframe application,
-//!   [`view_state`] what it has open, [`panels`] its widgets ([`room_panel`] the room tools'),
+//!   [`view_state`] what it has open, [`panels`] its widgets ([`room_panel`] the room tools',
+//!   [`sequence_panel`] an outdoor sequence's, played by [`sequence_state`]),
 //!   [`scene_save`] saving the scene.
 //!
 //! The extension points the indoor and outdoor pipelines plug into: [`lighting::SceneLighting`]
@@ -63,6 +66,9 @@ pub mod scene_model;
 pub mod scene_pass;
 pub mod scene_renderer;
 pub mod scene_save;
+pub mod sequence_panel;
+pub mod sequence_player;
+pub mod sequence_state;
 pub mod shadow_atlas;
 pub mod textures;
 pub mod timing;

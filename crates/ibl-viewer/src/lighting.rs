@@ -37,8 +37,6 @@ pub struct SceneLighting {
     pub lights: Vec<DirectionalLight>,
     /// Hybrid mode: the ambient's irradiance `E(n)` on a world-frame lat-long grid.
     pub ambient: Option<Image<Rgb>>,
-    /// The light set in the probe frame, as extracted.
-    pub set: LightSet,
     /// A short description: `16 median-cut lights`, `8 lightgen lights + SH9 ambient`.
     pub summary: String,
 }
@@ -89,7 +87,6 @@ pub fn scene_lighting(request: &SceneLightingRequest) -> Result<SceneLighting, S
         ambient: ambient
             .as_ref()
             .map(|sh| irradiance_map(sh, IRRADIANCE_MAP_WIDTH)),
-        set,
         summary: format!("{summary}, {} shadows", plan.shadows.name()),
     })
 }

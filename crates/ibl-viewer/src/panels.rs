@@ -1,5 +1,6 @@
 //! The window's widgets: the side panel (view, display, lights, the room tools of
-//! [`crate::room_panel`], the selected object, saving),
+//! [`crate::room_panel`], an outdoor sequence's of [`crate::sequence_panel`], the selected
+//! object, saving),
 //! the status line (frame rate, lights, shadow maps, GPU, messages) and the messages over an
 //! empty or failed view.
 
@@ -12,6 +13,7 @@ use ibl_scene::description::{CompositeRule, MaterialDescription, MaterialKind, R
 
 use crate::probe_pass::{ProbeLayer, ProbeProjection};
 use crate::scene_renderer::GlossySource;
+use crate::sequence_panel::sequence_section;
 use crate::view_state::{Content, ProbeState, SceneCamera, SceneState};
 
 /// Width of the side panel, points.
@@ -199,6 +201,16 @@ fn scene_panel(ui: &mut egui::Ui, s: &mut SceneState, gpu_changed: &mut bool) {
     ui.heading("Scene");
     ui.label(s.model.path.display().to_string());
     ui.separator();
+    if let Some(sequence) = &mut s.sequence {
+        sequence_section(ui, sequence);
+        ui.separator();
+        ui.label("Display");
+        let automatic = crate::headless::auto_exposure(&s.model);
+        display_controls(ui, &mut s.display, automatic);
+        ui.separator();
+        object_panel(ui, s, gpu_changed);
+        return;
+    }
     ui.label("Lighting");
     let d = &mut s.model.description;
     let mut mode = match d.render.mode {

@@ -156,6 +156,17 @@ impl SceneModel {
         materials
     }
 
+    /// Whether a virtual object reflects the environment (a mirror, or a glossy lobe that may be
+    /// drawn from the prefiltered probe): a changing environment must then be uploaded again.
+    pub fn reflects_environment(&self) -> bool {
+        let materials = self.materials();
+        self.geometry.objects.iter().any(|g| {
+            g.materials
+                .clone()
+                .any(|slot| !matches!(materials[slot as usize], Material::Diffuse { .. }))
+        })
+    }
+
     /// The material of object `i` if the user set one (`None`: the file's own materials).
     fn edited_material(&self, i: usize) -> Option<Material> {
         let now = &self.description.object[i];

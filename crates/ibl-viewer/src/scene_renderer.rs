@@ -7,6 +7,7 @@
 
 use glam::{Affine3A, Vec3};
 use ibl_core::tonemap::Display;
+use ibl_core::{Image, Rgb};
 use ibl_scene::Background;
 use ibl_scene::description::CompositeRule;
 
@@ -86,27 +87,44 @@ pub struct SceneRenderer {
     real_plane: Option<(Vec3, f32)>,
     /// Pass times of the latest frame whose timestamps were read.
     pub last_pass_times: Option<PassTimes>,
+    /// The photo background set by [`SceneRenderer::set_photo`] (a sequence's frame), at its
+    /// own size, kept to be resampled again when the output size changes.
+    photo_source: Option<Image<Rgb>>,
 }
 
 fn photo_texture(
     gpu: &GpuContext,
     model: &SceneModel,
+    source: Option<&Image<Rgb>>,
     width: u32,
     height: u32,
-) -> Result<HdrTexture, ViewerError> {
-    match &model.scene.background {
-        Background::Photo(_) => {
-            let image = ibl_render::background::background_image(&model.scene, width, height);
-            Ok(upload_hdr(
-                &gpu.device,
-                &gpu.queue,
-                &image,
-                "background photo",
-                1,
-                wgpu::TextureUsages::empty(),
-            ))
+) -> HdrTexture {
+    let image = match (source, &model.scene.background) {
+        (Some(photo), _) => resized(photo, width, height),
+        (None, Background::Photo(_)) => {
+            ibl_render::background::background_image(&model.scene, width, height)
         }
-        Background::Panorama => Ok(black_texture(&gpu.device, &gpu.queue, "no photo")),
+        (None, Background::Panorama) => {
+            return black_texture(&gpu.device, &gpu.queue, "no photo");
+        }
+    };
+    upload_hdr(
+        &gpu.device,
+        &gpu.queue,
+        &image,
+        "background photo",
+        1,
+        wgpu::TextureUsages::empty(),
+    )
+}
+
+/// `photo` at `width x height` (area-weighted, as `ibl render` resamples a photo background).
+fn resized(photo: &Image<Rgb>, width: u32, height: u32) -> Image<Rgb> {
+    let (w, h) = (width as usize, height as usize);
+    if (photo.width(), photo.height()) == (w, h) {
+        photo.clone()
+    } else {
+        ibl_render::background::area_resize(photo, w, h)
     }
 }
 
@@ -125,7 +143,7 @@ impl SceneRenderer {
         let scene_pass = ScenePass::new(gpu);
         let shadows = ShadowAtlases::new(gpu, 1, shadow_tile);
         let ambient = black_texture(&gpu.device, &gpu.queue, "no ambient");
-        let photo = photo_texture(gpu, model, width, height)?;
+        let photo = photo_texture(gpu, model, None, width, height);
         let bind_group = scene_pass.bind_group(
             gpu,
             &gpu_scene,
@@ -154,6 +172,7 @@ impl SceneRenderer {
             timer: PassTimer::new(gpu, &SCENE_PASSES),
             real_plane: model.geometry.real_plane(),
             last_pass_times: None,
+            photo_source: None,
         })
     }
 
@@ -197,9 +216,26 @@ impl SceneRenderer {
             return Ok(());
         }
         self.targets = FrameTargets::new(gpu, width, height)?;
-        self.photo = photo_texture(gpu, model, width, height)?;
+        self.photo = photo_texture(gpu, model, self.photo_source.as_ref(), width, height);
         self.rebind(gpu);
         Ok(())
+    }
+
+    /// Replaces the photo background by `photo` (a sequence's frame, linear radiance, any size
+    /// of the camera's aspect: resampled to the output size). The scene's background must be a
+    /// photo for the scene pass to show it.
+    pub fn set_photo(&mut self, gpu: &GpuContext, model: &SceneModel, photo: Image<Rgb>) {
+        let (w, h) = self.targets.size;
+        self.photo = photo_texture(gpu, model, Some(&photo), w, h);
+        self.photo_source = Some(photo);
+        self.rebind(gpu);
+    }
+
+    /// Replaces the environment mirrors and glossy lobes reflect (a sequence's relit map,
+    /// lat-long in the probe's frame) and rebuilds its mip chains.
+    pub fn set_environment(&mut self, gpu: &GpuContext, probe: &Image<Rgb>) {
+        self.environment = EnvironmentMaps::new(gpu, probe);
+        self.rebind(gpu);
     }
 
     /// Replaces the lights (from the lighting worker).

@@ -23,6 +23,7 @@ use crate::probe_model::{Overlays, ProbeModel, ProbeViewSettings};
 use crate::probe_pass::{ProbeLayer, ProbeProjection};
 use crate::room_overlay::RoomOverlay;
 use crate::scene_model::SceneModel;
+use crate::sequence_player::{PlayedFrame, SequencePlayer};
 use crate::view_camera::OrbitControl;
 use crate::{GpuContext, ViewerError};
 
@@ -160,6 +161,8 @@ pub enum ViewKind {
     Probe,
     /// A scene file.
     Scene,
+    /// A scene file with an `[outdoor]` table, played as a sequence.
+    Sequence,
 }
 
 /// One frame in the summary.
@@ -210,6 +213,18 @@ pub struct ViewSummary {
     pub per_frame: Vec<FrameSummary>,
     /// Files written.
     pub outputs: Vec<String>,
+    /// The sequence played (a sequence only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sequence: Option<SequenceSummary>,
+}
+
+/// What a sequence run played.
+#[derive(Clone, Debug, Serialize)]
+pub struct SequenceSummary {
+    /// Seconds of the offline step (maps, sample sites, volume weights), before the first frame.
+    pub setup_seconds: f64,
+    /// Every frame played, with its estimate and the CPU seconds of each step.
+    pub frames: Vec<PlayedFrame>,
 }
 
 /// Whether `path` is a scene file (`.toml`) rather than a probe.
@@ -340,13 +355,34 @@ impl ViewJob {
             self.apply_scene_overrides(&mut model)?;
             check_outputs(outputs.as_ref(), &model.inputs)?;
             options.display = Some(self.display(headless::auto_exposure(&model))?);
-            let gpu = GpuContext::headless()?;
-            progress.begin("frames", frames);
-            let run = headless::render_scene(&gpu, &model, &options, &|d, t| {
-                progress.update(d as u64, t as u64, None);
-            });
-            progress.end();
-            (run?, ViewKind::Scene)
+            if SequencePlayer::is_sequence(&model.description) {
+                options.motion = Motion::Sequence;
+                let centre = model.objects_sphere().map(|(c, _)| c);
+                progress.begin("sequence: offline maps and sample sites", 0);
+                let written: Vec<&Path> = outputs
+                    .iter()
+                    .flat_map(|(png, exr)| [png.as_path(), exr.as_path()])
+                    .collect();
+                let player = SequencePlayer::open(&self.input, centre, &written);
+                progress.end();
+                let mut player = player?;
+                let gpu = GpuContext::headless()?;
+                progress.begin("frames", frames);
+                let run =
+                    headless::render_sequence(&gpu, &model, &mut player, &options, &|d, t| {
+                        progress.update(d as u64, t as u64, None);
+                    });
+                progress.end();
+                (run?, ViewKind::Sequence)
+            } else {
+                let gpu = GpuContext::headless()?;
+                progress.begin("frames", frames);
+                let run = headless::render_scene(&gpu, &model, &options, &|d, t| {
+                    progress.update(d as u64, t as u64, None);
+                });
+                progress.end();
+                (run?, ViewKind::Scene)
+            }
         } else {
             let model = ProbeModel::open(&self.input, self.mapping)?;
             let mut inputs = extras.inputs();
@@ -375,7 +411,14 @@ impl ViewJob {
             write_frame(&run, png, exr)?;
             written = vec![png.display().to_string(), exr.display().to_string()];
         }
-        Ok(summary(&self.input, &run, kind, options.motion, written))
+        let mut summary = summary(&self.input, &run, kind, options.motion, written);
+        if kind == ViewKind::Sequence {
+            summary.sequence = Some(SequenceSummary {
+                setup_seconds: run.setup_seconds.unwrap_or(0.0),
+                frames: run.played,
+            });
+        }
+        Ok(summary)
     }
 }
 
@@ -424,6 +467,7 @@ fn summary(
             })
             .collect(),
         outputs,
+        sequence: None,
     }
 }
 

@@ -24,6 +24,7 @@ use crate::room_marking::{PendingLine, RoomSession};
 use crate::room_overlay::{OverlayView, perspective_view};
 use crate::scene_model::{DragAction, SceneModel};
 use crate::scene_renderer::{GlossySource, SceneFrameSettings, SceneRenderer};
+use crate::sequence_state::SequenceState;
 use crate::view_camera::{OrbitControl, OutputCamera};
 use crate::view_job::ProbeExtras;
 use crate::worker::LatestWorker;
@@ -108,6 +109,9 @@ pub struct SceneState {
     pub last_camera: Option<OutputCamera>,
     /// The object under the cursor.
     pub hovered: Option<usize>,
+    /// The outdoor sequence played (a scene with an `[outdoor]` table): its frames, sun and
+    /// sky replace the background and the scene's `[lighting]`.
+    pub sequence: Option<SequenceState>,
 }
 
 /// What the window has open.
@@ -149,6 +153,7 @@ impl Content {
         }
         if is_scene {
             let model = SceneModel::open(path)?;
+            let sequence = SequenceState::open(&model)?;
             let renderer = SceneRenderer::new(gpu, &model, size.0, size.1, shadow_tile)?;
             let display = Display {
                 exposure_stops: crate::headless::auto_exposure(&model),
@@ -182,6 +187,7 @@ impl Content {
                 lighting_seconds: 0.0,
                 last_camera: None,
                 hovered: None,
+                sequence,
             })))
         } else {
             let model = ProbeModel::open(path, mapping)?;
@@ -225,13 +231,17 @@ impl Content {
         match self {
             Content::Empty => false,
             Content::Probe(p) => p.worker.busy() || p.requested.is_none(),
+            Content::Scene(s) if s.sequence.is_some() => false,
             Content::Scene(s) => s.worker.busy() || s.requested.is_none(),
         }
     }
 
-    /// Whether the window should keep repainting (a worker result is awaited).
+    /// Whether the window should keep repainting (a worker result is awaited, or a sequence
+    /// plays).
     pub fn animating(&self) -> bool {
-        self.busy()
+        let playing =
+            matches!(self, Content::Scene(s) if s.sequence.as_ref().is_some_and(|q| q.playing));
+        playing || self.busy()
     }
 
     /// Submits work whose inputs changed and takes finished results.
@@ -257,6 +267,21 @@ impl Content {
                         Ok(())
                     }
                     None => Ok(()),
+                }
+            }
+            Content::Scene(s) if s.sequence.is_some() => {
+                let SceneState {
+                    model,
+                    renderer,
+                    display,
+                    sequence,
+                    ..
+                } = &mut **s;
+                match sequence {
+                    Some(q) if q.due(std::time::Instant::now()) => q
+                        .advance(gpu, model, renderer, display)
+                        .map_err(|e| e.to_string()),
+                    _ => Ok(()),
                 }
             }
             Content::Scene(s) => {

@@ -14,7 +14,6 @@
 
 mod common;
 
-use ibl_golden::{Goldens, Metric, Mode};
 use ibl_render::{RenderSettings, render};
 use ibl_scene::{RenderMode, ShadowKind};
 use ibl_viewer::SceneModel;
@@ -58,33 +57,8 @@ fn compare(name: &str) {
         (WIDTH as usize, HEIGHT as usize)
     );
 
-    let gpu_image = &gpu_run.images.radiance;
-    let masks_equal = gpu_run
-        .images
-        .coverage
-        .pixels()
-        .iter()
-        .zip(cpu.object_coverage.pixels())
-        .filter(|(g, c)| (**g > 0.5) == (**c > 0.5))
-        .count() as f64
-        / cpu.object_coverage.len() as f64;
-    // The CPU render is the golden, made fresh: the golden helper compares (never blesses: this
-    // golden is not a stored file) and leaves the images and their difference in
-    // target/golden-failures/viewer-<name>/ when FLIP is over the issue's threshold.
-    let dir = tempfile::tempdir().expect("a temporary folder");
-    let golden = dir.path().join("cpu.exr");
-    ibl_io::write_image(&golden, &cpu.composite, &ibl_io::WriteOptions::default())
-        .expect("writes the CPU render");
-    let goldens = Goldens {
-        mode: Mode::Compare,
-        ..Goldens::from_env()
-    };
-    let outcome = goldens.check(
-        &format!("viewer-{name}"),
-        gpu_image,
-        &golden,
-        Metric::MeanFlip(0.05),
-    );
+    let (outcome, masks_equal) =
+        common::against_cpu(&format!("viewer-{name}"), &gpu_run.images, &cpu, 0.05);
     eprintln!(
         "{name}: {outcome:?}, coverage masks equal on {:.3} % (GPU {gpu_seconds:.1} s, CPU \
          {cpu_seconds:.1} s)",

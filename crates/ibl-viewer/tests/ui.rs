@@ -210,3 +210,41 @@ fn the_room_tools_mark_a_line_remove_it_and_calibrate() {
     assert_eq!(probe(h.state()).room.line_count(), 13);
     assert!(probe(h.state()).room.calibration.is_none());
 }
+
+fn sequence_frames(app: &ViewerApp) -> usize {
+    match &app.content {
+        Content::Scene(s) => s.sequence.as_ref().map_or(0, |q| q.history.len()),
+        _ => 0,
+    }
+}
+
+#[test]
+fn an_outdoor_scene_plays_its_sequence_with_the_estimates_in_the_panel() {
+    let Some(gpu) = common::gpu_or_skip("ui sequence") else {
+        return;
+    };
+    let scene = common::assets().join("outdoor/courtyard/scene.toml");
+    let mut h = harness_with(&gpu, Some(scene), ProbeExtras::default(), 900.0);
+    // The first frame is played at once; the sun is the one light.
+    step_until(&mut h, |app| sequence_frames(app) >= 1);
+    assert!(h.state().error.is_none(), "{:?}", h.state().error);
+    assert_eq!(lights_drawn(h.state()), 1);
+    h.get_by_label("pause").click();
+    h.step();
+    let before = sequence_frames(h.state());
+    h.get_by_label("next frame").click();
+    step_until(&mut h, |app| sequence_frames(app) == before + 1);
+    match &h.state().content {
+        Content::Scene(s) => {
+            let q = s.sequence.as_ref().expect("a sequence");
+            assert!(!q.playing);
+            let f = q.current().expect("a frame");
+            assert_eq!(f.index, before);
+        }
+        _ => panic!("a scene is open"),
+    }
+    // The estimates and the relit map are in the panel.
+    h.get_by_label_contains("sun P_d");
+    h.get_by_label_contains("sky P_a");
+    h.get_by_label("relit environment map (the sun left out)");
+}

@@ -41,3 +41,40 @@ pub fn failure_dir(test: &str) -> PathBuf {
     let _ = std::fs::create_dir_all(&dir);
     dir
 }
+
+/// The viewer's frame against a CPU render of the same frame, through the image-golden helper
+/// (`ibl-golden`; the CPU render is written as a fresh golden, compared, never blessed; failing
+/// images go to target/golden-failures/NAME/): the mean-FLIP outcome at `max_flip`, and the
+/// fraction of pixels whose coverage masks (alpha > 0.5) agree.
+pub fn against_cpu(
+    name: &str,
+    gpu: &ibl_viewer::frame_targets::FrameImages,
+    cpu: &ibl_render::RenderOutput,
+    max_flip: f64,
+) -> (Result<ibl_golden::Outcome, String>, f64) {
+    let masks_equal = gpu
+        .coverage
+        .pixels()
+        .iter()
+        .zip(cpu.object_coverage.pixels())
+        .filter(|(g, c)| (**g > 0.5) == (**c > 0.5))
+        .count() as f64
+        / cpu.object_coverage.len() as f64;
+    let dir = tempfile::tempdir().expect("a temporary folder");
+    let golden = dir.path().join("cpu.exr");
+    ibl_io::write_image(&golden, &cpu.composite, &ibl_io::WriteOptions::default())
+        .expect("writes the CPU render");
+    let goldens = ibl_golden::Goldens {
+        mode: ibl_golden::Mode::Compare,
+        ..ibl_golden::Goldens::from_env()
+    };
+    let outcome = goldens
+        .check(
+            name,
+            &gpu.radiance,
+            &golden,
+            ibl_golden::Metric::MeanFlip(max_flip),
+        )
+        .map_err(|e| e.to_string());
+    (outcome, masks_equal)
+}
