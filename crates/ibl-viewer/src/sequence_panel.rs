@@ -39,10 +39,10 @@ pub fn sequence_section(ui: &mut egui::Ui, sequence: &mut SequenceState) {
     let count = sequence
         .frame_count()
         .map_or("a video".to_string(), |n| format!("{n} frames"));
-    ui.label(format!(
-        "{count}; offline step {:.2} s",
-        sequence.setup_seconds
-    ));
+    match sequence.setup_seconds {
+        Some(t) => ui.label(format!("{count}; offline step {t:.2} s")),
+        None => ui.label(format!("{count}; offline step running...")),
+    };
     if let Some(f) = sequence.current() {
         let e = &f.result.estimate;
         ui.label(format!(

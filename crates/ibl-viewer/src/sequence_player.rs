@@ -83,30 +83,63 @@ pub struct SequencePlayer {
     pub frame_count: Option<usize>,
 }
 
+/// A sequence opened and checked, before its offline step.
+pub struct PreparedSequence {
+    sequence: OutdoorSequence,
+    objects_centre: Option<Vec3>,
+}
+
+impl PreparedSequence {
+    /// Frames in the sequence (`None` for a video).
+    pub fn frame_count(&self) -> Option<usize> {
+        self.sequence.frame_count()
+    }
+
+    /// The offline step (Jensen, Andersen & Madsen 2006 section 4; about a second and a half
+    /// for the bundled courtyard): the player, ready for its first frame.
+    pub fn start(self) -> Result<SequencePlayer, ViewerError> {
+        let started = Instant::now();
+        let system = self.sequence.system()?;
+        Ok(SequencePlayer {
+            frame_count: self.sequence.frame_count(),
+            setup_seconds: started.elapsed().as_secs_f64(),
+            ambient_point: self.objects_centre,
+            ambient_bands: CompositeSettings::default().ambient_bands,
+            sequence: self.sequence,
+            system,
+        })
+    }
+}
+
 impl SequencePlayer {
-    /// Opens a scene's sequence and runs the offline step (seconds); `objects_centre` is where
-    /// the ambient is read from the volume; `outputs` (the files the caller will write) are
-    /// refused, before the offline step, when one is an input of the sequence.
+    /// Opens a scene's sequence and runs the offline step (seconds): [`SequencePlayer::prepare`]
+    /// then [`PreparedSequence::start`].
     pub fn open(
         scene: &Path,
         objects_centre: Option<Vec3>,
         outputs: &[&Path],
     ) -> Result<SequencePlayer, ViewerError> {
+        SequencePlayer::prepare(scene, objects_centre, outputs)?.start()
+    }
+
+    /// Opens a scene's sequence and checks it (the scene, the mask, the frames and their
+    /// times), without the offline step; `objects_centre` is where the ambient is read from the
+    /// volume; `outputs` (the files the caller will write) are refused when one is an input of
+    /// the sequence.
+    pub fn prepare(
+        scene: &Path,
+        objects_centre: Option<Vec3>,
+        outputs: &[&Path],
+    ) -> Result<PreparedSequence, ViewerError> {
         let sequence = OutdoorSequence::open(scene, None)?;
         let inputs = sequence.inputs();
         let inputs: Vec<&Path> = inputs.iter().map(PathBuf::as_path).collect();
         for output in outputs {
             ibl_io::ensure_output_is_not_input(output, &inputs)?;
         }
-        let started = Instant::now();
-        let system = sequence.system()?;
-        Ok(SequencePlayer {
-            frame_count: sequence.frame_count(),
-            setup_seconds: started.elapsed().as_secs_f64(),
-            ambient_point: objects_centre,
-            ambient_bands: CompositeSettings::default().ambient_bands,
+        Ok(PreparedSequence {
             sequence,
-            system,
+            objects_centre,
         })
     }
 

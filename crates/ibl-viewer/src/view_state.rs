@@ -231,7 +231,9 @@ impl Content {
         match self {
             Content::Empty => false,
             Content::Probe(p) => p.worker.busy() || p.requested.is_none(),
-            Content::Scene(s) if s.sequence.is_some() => false,
+            Content::Scene(s) if s.sequence.is_some() => {
+                s.sequence.as_ref().is_some_and(SequenceState::busy)
+            }
             Content::Scene(s) => s.worker.busy() || s.requested.is_none(),
         }
     }
@@ -278,10 +280,10 @@ impl Content {
                     ..
                 } = &mut **s;
                 match sequence {
-                    Some(q) if q.due(std::time::Instant::now()) => q
-                        .advance(gpu, model, renderer, display)
+                    Some(q) => q
+                        .poll(gpu, model, renderer, display)
                         .map_err(|e| e.to_string()),
-                    _ => Ok(()),
+                    None => Ok(()),
                 }
             }
             Content::Scene(s) => {
