@@ -69,6 +69,8 @@ Examples:
   ibl view assets/outdoor/courtyard/scene.toml --headless --bench --frames 24 --json
   ibl view probe.exr --marks marks.json --room room.toml  marked lines and the room over the probe
   ibl view probe.exr --marks marks.json --headless --yaw 30 --fov 100 -o shot.png
+  ibl view assets/probes/apartment.exr --room assets/rooms/apartment/room.toml \
+      --edit assets/rooms/apartment/edits-light.toml      the room with a new IES light
 
 In the window: left-drag turns the camera (or moves the object under the cursor), Shift-drag
 turns the object, Ctrl-drag scales it, right-drag pans, the wheel zooms; F12 saves the frame as
@@ -83,7 +85,9 @@ their chart and the relit map. Headless, --frames K plays K sequence frames.
 Room tools (probe; docs/ROOMS.md): marked lines are drawn x red, y green, z blue, the room's
 edges white. In the window's Room section, M switches marking on: a left-drag draws a line
 (right-drag turns), X/Y/Z pick its axis, Backspace removes the last; \"calibrate\" runs `ibl
-room calibrate`'s calibration, \"save marks\" writes the marks file.")]
+room calibrate`'s calibration, \"save marks\" writes the marks file. \"edit the room's materials\"
+estimates the room; then a click picks a surface's group and a colour sets its new reflectance,
+shown at once with its colour bleeding (Grosch 2005 section 4.3).")]
 pub struct ViewArgs {
     /// A probe (any format and mapping ibl reads) or a scene file (.toml, docs/SCENES.md).
     pub input: PathBuf,
@@ -152,9 +156,14 @@ pub struct ViewArgs {
     /// window's Room section adds to them and saves them.
     #[arg(long, value_name = "MARKS.json")]
     pub marks: Option<PathBuf>,
-    /// Room file (docs/ROOMS.md) whose edges are drawn over a probe, seen from its probe.
+    /// Room file (docs/ROOMS.md) whose edges are drawn over a probe, seen from its probe; the
+    /// window's Room section edits its materials by clicking.
     #[arg(long, value_name = "ROOM.toml")]
     pub room: Option<PathBuf>,
+    /// Edits file (`ibl room render --edit`'s: materials, lights, objects) applied to --room:
+    /// the edited panorama is shown instead of the probe.
+    #[arg(long, value_name = "EDITS.toml", requires = "room")]
+    pub edit: Option<PathBuf>,
     /// Camera yaw over a probe, degrees (0 looks along -Z, positive looks left).
     #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
     pub yaw: Option<f32>,
@@ -175,6 +184,7 @@ impl ViewArgs {
             fov_deg: self.fov,
             marks: self.marks.clone(),
             room: self.room.clone(),
+            edit: self.edit.clone(),
         }
     }
 }

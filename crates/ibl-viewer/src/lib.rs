@@ -13,7 +13,8 @@
 //! - [`view_camera`]: the pinhole camera of `ibl_scene` as a projection, and orbit controls.
 //! - [`room_overlay`]: a marks file's lines and a room file's edges as segments in the current
 //!   view (Grosch 2005 section 3.1); [`room_marking`]: the marks being edited in the window
-//!   (adding lines, calibrating, saving).
+//!   (adding lines, calibrating, saving); [`room_edit`]: the room's materials changed by
+//!   clicking a surface, with colour bleeding (Grosch 2005 section 4.3).
 //! - [`light_space`]: orthographic shadow projections and the atlas layout.
 //! - [`sequence_player`]: an outdoor scene's frames played through the library's per-frame sun
 //!   and sky estimation (Jensen, Andersen & Madsen 2006), as lights, ambient and background.
@@ -58,6 +59,7 @@ pub mod panels;
 pub mod probe_model;
 pub mod probe_pass;
 pub mod probe_renderer;
+pub mod room_edit;
 pub mod room_marking;
 pub mod room_overlay;
 pub mod room_panel;

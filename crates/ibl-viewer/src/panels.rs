@@ -156,6 +156,10 @@ fn probe_panel(ui: &mut egui::Ui, p: &mut ProbeState) {
     ui.separator();
     let look_around = p.settings.projection == ProbeProjection::LookAround;
     crate::room_panel::room_section(ui, &mut p.room, look_around);
+    if p.room.room_path.is_some() {
+        ui.separator();
+        crate::room_panel::materials_section(ui, &p.room, &mut p.edit);
+    }
     ui.separator();
     if let Some((d, l)) = p.cursor {
         let elevation = d.y.clamp(-1.0, 1.0).asin().to_degrees();

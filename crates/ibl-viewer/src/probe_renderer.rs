@@ -72,6 +72,12 @@ impl ProbeRenderer {
         Ok(())
     }
 
+    /// Replaces the probe shown (an edited panorama of the same lat-long layout) and rebuilds
+    /// its mip chains.
+    pub fn set_probe(&mut self, gpu: &GpuContext, latlong: &ibl_core::Image<ibl_core::Rgb>) {
+        self.environment = EnvironmentMaps::new(gpu, latlong);
+    }
+
     /// Replaces the overlay (from the worker).
     pub fn set_overlay(&mut self, gpu: &GpuContext, overlay: ProbeOverlay) {
         self.irradiance = upload_hdr(

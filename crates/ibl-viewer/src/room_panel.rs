@@ -1,13 +1,16 @@
 //! The "Room" section of the probe viewer's side panel (Grosch 2005 section 3.1): what the marks
 //! and the room hold, the overlays' switches, marking lines (the axis of the next one, removing
-//! the last), calibrating with every line's residual, and saving the marks. The state and what
-//! the buttons do are [`crate::room_marking`]'s.
+//! the last), calibrating with every line's residual, and saving the marks; and the room's
+//! materials changed by clicking ([`materials_section`]). The state and what the buttons do are
+//! [`crate::room_marking`]'s and [`crate::room_edit`]'s.
 
 use eframe::egui;
 use ibl_room::Axis;
 
+use crate::room_edit::{MAX_BOUNCES, RoomEditSession};
 use crate::room_marking::RoomSession;
 use crate::room_overlay::axis_colour;
+use ibl_core::Rgb;
 
 fn colour32(c: [f32; 4]) -> egui::Color32 {
     let [r, g, b, _] = c.map(|v| (v.clamp(0.0, 1.0) * 255.0).round() as u8);
@@ -133,5 +136,82 @@ fn calibration(ui: &mut egui::Ui, room: &RoomSession) {
                     });
                 });
         }
+    }
+}
+
+/// The room's materials, changed by clicking (Grosch 2005 section 4.3; [`crate::room_edit`]):
+/// switched on here once a room file is open, then a click on the panorama picks a surface's
+/// group, a colour sets its new reflectance and the edited panorama with its colour bleeding
+/// replaces the probe.
+pub fn materials_section(
+    ui: &mut egui::Ui,
+    room: &RoomSession,
+    edit: &mut Option<RoomEditSession>,
+) {
+    let Some(path) = &room.room_path else {
+        return;
+    };
+    ui.label("Materials (Grosch 4.3)");
+    let Some(session) = edit else {
+        if ui
+            .button("edit the room's materials")
+            .on_hover_text("estimates the room's reflectances (about a second), then a click on a surface picks its group")
+            .clicked()
+        {
+            *edit = Some(RoomEditSession::new(path));
+        }
+        return;
+    };
+    ui.horizontal(|ui| {
+        ui.checkbox(&mut session.picking, "click picks a surface");
+        ui.checkbox(&mut session.show_edited, "show the edits");
+    });
+    ui.add(
+        egui::Slider::new(&mut session.bounces, 1..=MAX_BOUNCES).text("bounces of colour bleeding"),
+    );
+    if session.table.is_none() {
+        ui.label("estimating the room...");
+    }
+    if let (Some(g), Some(table)) = (session.picked, session.table.clone())
+        && let Some(info) = table.groups.get(g)
+    {
+        match (info.estimated, session.reflectance(g)) {
+            (Some(estimated), Some(now)) => {
+                ui.label(format!(
+                    "{}: estimated reflectance {:.3} {:.3} {:.3}",
+                    info.name, estimated.r, estimated.g, estimated.b
+                ));
+                let mut rgb = now.to_array();
+                ui.horizontal(|ui| {
+                    ui.label("new reflectance");
+                    if ui.color_edit_button_rgb(&mut rgb).changed() {
+                        session.set_reflectance(g, Rgb::from_array(rgb));
+                    }
+                });
+            }
+            _ => {
+                ui.label(format!(
+                    "{}: a light or unseen group (no reflectance)",
+                    info.name
+                ));
+            }
+        }
+    } else if session.table.is_some() {
+        ui.label("click a surface of the panorama to pick its group");
+    }
+    for (name, rho) in &session.materials {
+        ui.label(format!("{name} -> {:.3} {:.3} {:.3}", rho.r, rho.g, rho.b));
+    }
+    if !session.materials.is_empty() && ui.button("undo all").clicked() {
+        session.materials.clear();
+    }
+    match &session.last {
+        Some(Ok((line, _))) if !session.materials.is_empty() => {
+            ui.label(line.as_str());
+        }
+        Some(Err(e)) => {
+            ui.colored_label(egui::Color32::from_rgb(255, 110, 100), e.as_str());
+        }
+        _ => {}
     }
 }

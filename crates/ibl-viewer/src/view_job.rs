@@ -60,6 +60,9 @@ pub struct ProbeExtras {
     pub marks: Option<PathBuf>,
     /// A room file whose edges are drawn.
     pub room: Option<PathBuf>,
+    /// An edits file (`ibl room render --edit`'s, docs/ROOMS.md) applied to the room: the
+    /// edited panorama is shown instead of the probe (needs `room`).
+    pub edit: Option<PathBuf>,
 }
 
 impl ProbeExtras {
@@ -70,7 +73,12 @@ impl ProbeExtras {
 
     /// The files it reads (checked against the outputs).
     pub fn inputs(&self) -> Vec<PathBuf> {
-        self.marks.iter().chain(&self.room).cloned().collect()
+        self.marks
+            .iter()
+            .chain(&self.room)
+            .chain(&self.edit)
+            .cloned()
+            .collect()
     }
 
     /// Turns `orbit` as asked (angles checked).
@@ -109,6 +117,14 @@ impl ProbeExtras {
             vertical_fov: 1.0,
         };
         self.aim(&mut orbit)?;
+        if self.edit.is_some() && self.room.is_none() {
+            return Err(ViewerError::Parameter(
+                "--edit applies an edits file to a room: give the room with --room".into(),
+            ));
+        }
+        if let Some(edit) = &self.edit {
+            crate::room_edit::read_panorama_edits(edit)?;
+        }
         self.overlay().map(|_| ())
     }
 
@@ -384,13 +400,20 @@ impl ViewJob {
                 (run?, ViewKind::Scene)
             }
         } else {
-            let model = ProbeModel::open(&self.input, self.mapping)?;
+            let mut model = ProbeModel::open(&self.input, self.mapping)?;
             let mut inputs = extras.inputs();
             inputs.push(self.input.clone());
             check_outputs(outputs.as_ref(), &inputs)?;
             let mut settings = self.probe_settings(&model)?;
+            extras.check()?;
             extras.aim(&mut settings.orbit)?;
             let room = extras.overlay()?;
+            if let (Some(room), Some(edit)) = (&extras.room, &extras.edit) {
+                progress.begin("room: estimate and edits", 0);
+                let edited = crate::room_edit::edited_panorama(room, edit, &model.latlong);
+                progress.end();
+                model.latlong = std::sync::Arc::new(edited?);
+            }
             let gpu = GpuContext::headless()?;
             progress.begin("frames", frames);
             let run = headless::render_probe_with(

@@ -20,6 +20,7 @@ use crate::lighting::{
 use crate::probe_model::{ProbeModel, ProbeViewSettings};
 use crate::probe_pass::ProbeProjection;
 use crate::probe_renderer::ProbeRenderer;
+use crate::room_edit::RoomEditSession;
 use crate::room_marking::{PendingLine, RoomSession};
 use crate::room_overlay::{OverlayView, perspective_view};
 use crate::scene_model::{DragAction, SceneModel};
@@ -61,6 +62,10 @@ pub struct ProbeState {
     pub cursor: Option<(Vec3, ibl_core::Rgb)>,
     /// The room tools: the marks being edited and the room shown over the probe.
     pub room: RoomSession,
+    /// Material changes of the room (once switched on in the Room section; needs a room file).
+    pub edit: Option<RoomEditSession>,
+    /// The probe as read (what the edits start from and what undoing them shows).
+    pub original: Arc<ibl_core::Image<ibl_core::Rgb>>,
 }
 
 /// How the scene camera is placed.
@@ -190,9 +195,18 @@ impl Content {
                 sequence,
             })))
         } else {
-            let model = ProbeModel::open(path, mapping)?;
+            let mut model = ProbeModel::open(path, mapping)?;
             let mut settings = ProbeViewSettings::for_probe(&model.latlong);
             extras.aim(&mut settings.orbit)?;
+            // An edits file's panorama replaces the probe (seconds: the estimate and the edits;
+            // the objects' display takes longest).
+            if let (Some(room), Some(edit)) = (&extras.room, &extras.edit) {
+                model.latlong = Arc::new(crate::room_edit::edited_panorama(
+                    room,
+                    edit,
+                    &model.latlong,
+                )?);
+            }
             let probe_size = (model.mapping == Mapping::LatLong)
                 .then(|| [model.latlong.width() as u32, model.latlong.height() as u32]);
             let room = RoomSession::open(
@@ -204,6 +218,8 @@ impl Content {
             let renderer = ProbeRenderer::new(gpu, &model, size.0, size.1)?;
             Ok(Content::Probe(Box::new(ProbeState {
                 room,
+                edit: None,
+                original: Arc::clone(&model.latlong),
                 model,
                 settings,
                 renderer,
@@ -230,7 +246,11 @@ impl Content {
     pub fn busy(&self) -> bool {
         match self {
             Content::Empty => false,
-            Content::Probe(p) => p.worker.busy() || p.requested.is_none(),
+            Content::Probe(p) => {
+                p.worker.busy()
+                    || p.requested.is_none()
+                    || p.edit.as_ref().is_some_and(|e| e.busy())
+            }
             Content::Scene(s) if s.sequence.is_some() => {
                 s.sequence.as_ref().is_some_and(SequenceState::busy)
             }
@@ -251,6 +271,10 @@ impl Content {
         match self {
             Content::Empty => Ok(()),
             Content::Probe(p) => {
+                if let Some(edited) = p.edit.as_mut().and_then(|e| e.poll(&p.original)) {
+                    p.renderer.set_probe(gpu, &edited);
+                    p.model.latlong = edited;
+                }
                 let wanted = (p.settings.spec, p.settings.lights, p.settings.bands);
                 if p.requested != Some(wanted) {
                     p.worker.submit(ProbeOverlayRequest {
@@ -549,6 +573,13 @@ impl ProbeState {
                 let d = self.settings.direction_at(px.x, px.y, size.0, size.1);
                 (d, self.model.radiance_towards(d))
             });
+        // A click picks the material group under the cursor while material editing picks.
+        if response.clicked_by(egui::PointerButton::Primary)
+            && let (Some(edit), Some((d, _))) = (self.edit.as_mut(), self.cursor)
+            && edit.picking
+        {
+            edit.pick(d);
+        }
     }
 }
 

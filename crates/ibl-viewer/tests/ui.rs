@@ -117,6 +117,24 @@ fn a_bad_file_is_reported_in_the_window() {
     h.get_by_label_contains("broken.toml");
 }
 
+/// The apartment probe with its room file (and `extras`), in a window tall enough for the side
+/// panel's Room section to show without scrolling.
+fn apartment_harness(
+    gpu: &ibl_viewer::GpuContext,
+    extras: ProbeExtras,
+) -> Harness<'static, ViewerApp> {
+    let room = common::assets().join("rooms/apartment/room.toml");
+    harness_with(
+        gpu,
+        Some(common::assets().join("probes/apartment.exr")),
+        ProbeExtras {
+            room: Some(room),
+            ..extras
+        },
+        1400.0,
+    )
+}
+
 fn probe(app: &ViewerApp) -> &ProbeState {
     match &app.content {
         Content::Probe(p) => p,
@@ -130,17 +148,13 @@ fn the_room_tools_mark_a_line_remove_it_and_calibrate() {
         return;
     };
     let apartment = common::assets().join("rooms/apartment");
-    let mut h = harness_with(
+    let mut h = apartment_harness(
         &gpu,
-        Some(common::assets().join("probes/apartment.exr")),
         ProbeExtras {
             yaw_deg: Some(20.0),
             marks: Some(apartment.join("marks.json")),
-            room: Some(apartment.join("room.toml")),
             ..ProbeExtras::default()
         },
-        // Tall enough for the side panel's Room section to show without scrolling.
-        1400.0,
     );
     h.step();
     assert_eq!(probe(h.state()).room.line_count(), 13);
@@ -247,4 +261,84 @@ fn an_outdoor_scene_plays_its_sequence_with_the_estimates_in_the_panel() {
     h.get_by_label_contains("sun P_d");
     h.get_by_label_contains("sky P_a");
     h.get_by_label("relit environment map (the sun left out)");
+}
+
+#[test]
+fn a_click_picks_the_floor_and_its_new_reflectance_edits_the_panorama() {
+    let Some(gpu) = common::gpu_or_skip("ui room materials") else {
+        return;
+    };
+    let mut h = apartment_harness(
+        &gpu,
+        ProbeExtras {
+            // Looking straight down at the floor.
+            pitch_deg: Some(-89.0),
+            ..ProbeExtras::default()
+        },
+    );
+    h.step();
+    h.get_by_label("edit the room's materials").click();
+    step_until(&mut h, |app| {
+        probe(app).edit.as_ref().is_some_and(|e| e.table.is_some())
+    });
+    h.get_by_label("click picks a surface").click();
+    h.step();
+    // A click (press and release in place) at the middle of the view picks the floor.
+    let middle = egui::pos2(305.0, 690.0);
+    h.hover_at(middle);
+    h.step();
+    h.drag_at(middle);
+    h.step();
+    h.drop_at(middle);
+    h.step();
+    let (floor, before) = {
+        let e = probe(h.state()).edit.as_ref().expect("editing");
+        let g = e.picked.expect("a group picked");
+        let table = e.table.as_ref().expect("the table");
+        assert_eq!(table.groups[g].name, "floor");
+        (g, table.groups[g].estimated.expect("the floor's estimate"))
+    };
+    // The floor's new reflectance, as edits.toml sets it (docs/ROOMS.md section 11).
+    let after = ibl_core::Rgb::new(0.60, 0.12, 0.08);
+    match &mut h.state_mut().content {
+        Content::Probe(p) => p
+            .edit
+            .as_mut()
+            .expect("editing")
+            .set_reflectance(floor, after),
+        _ => panic!("a probe is open"),
+    }
+    step_until(&mut h, |app| {
+        probe(app)
+            .edit
+            .as_ref()
+            .is_some_and(|e| e.materials.len() == 1 && e.shows_current_edits())
+    });
+    // At one bounce the floor's own pixels scale by rho' / rho exactly (its irradiance changes
+    // only at the second bounce): the pixel that was clicked.
+    let p = probe(h.state());
+    let d = p
+        .edit
+        .as_ref()
+        .and_then(|e| e.picked_towards)
+        .expect("picked along");
+    let (i, j) =
+        ibl_core::LatLong::new(p.original.width(), p.original.height()).dir_to_pixel(d.as_dvec3());
+    let (was, now) = (*p.original.get(i, j), *p.model.latlong.get(i, j));
+    for (c, (n, o)) in [(now.r, was.r), (now.g, was.g), (now.b, was.b)]
+        .iter()
+        .enumerate()
+    {
+        let ratio = [after.r / before.r, after.g / before.g, after.b / before.b][c];
+        assert!(
+            (n / o - ratio).abs() <= 1e-3 * ratio,
+            "channel {c}: {n} / {o} against rho'/rho {ratio}"
+        );
+    }
+    h.get_by_label_contains("bounce of colour bleeding");
+    // Switching the edits off shows the probe as read.
+    h.get_by_label("show the edits").click();
+    step_until(&mut h, |app| {
+        std::sync::Arc::ptr_eq(&probe(app).model.latlong, &probe(app).original)
+    });
 }
