@@ -4,7 +4,9 @@
 //! sees at that pixel), the panel sets the group's new reflectance `rho'`, and the viewer shows
 //! the edited panorama: the group's pixels scaled by `rho' / rho` at once and the rest of the
 //! room updated by the colour bleeding of `ibl room render --edit` (delta radiosity shot from the
-//! changed patches, `bounces` times).
+//! changed patches, `bounces` times). A click can also place a new IES or EULUMDAT light
+//! (section 4.2) on the surface it meets, moved off it along the surface's normal: its direct
+//! light with shadows and its bounces join the panorama.
 //!
 //! Everything is computed by the library's own calls, off the UI thread ([`crate::worker`]):
 //! `ibl_pipeline::room_estimate::estimate_room` once (the reflectance estimate, about 0.7 s for
@@ -19,7 +21,7 @@ use glam::Vec3;
 use ibl_core::{Image, LatLong, Rgb};
 use ibl_pipeline::progress::Silent;
 use ibl_pipeline::room_estimate::{EstimatedRoom, SamplingOptions, estimate_room};
-use ibl_pipeline::room_render::{EditReport, RoomEdits, render_edits};
+use ibl_pipeline::room_render::{EditReport, IntensityScale, LightSpec, RoomEdits, render_edits};
 use ibl_room::depth_map::NO_PATCH;
 
 use crate::ViewerError;
@@ -27,6 +29,22 @@ use crate::worker::LatestWorker;
 
 /// Most bounces of colour bleeding the panel offers.
 pub const MAX_BOUNCES: u32 = 4;
+/// A placed light's distance from the clicked surface, metres, unless changed.
+pub const DEFAULT_LIGHT_OFFSET_M: f32 = 0.3;
+/// A placed light's peak, probe units per sr, unless changed (the worked example's).
+pub const DEFAULT_LIGHT_PEAK: f32 = 40.0;
+
+/// The light file offered first: the bundled `umbrella.ies` when the room sits in the
+/// repository's `assets/rooms/NAME/` (as the worked example does), else none.
+fn default_light_file(room: &Path) -> String {
+    let bundled = room
+        .parent()
+        .map(|dir| dir.join("../../photometry/ies/umbrella.ies"));
+    match bundled {
+        Some(p) if p.is_file() => p.display().to_string(),
+        _ => String::new(),
+    }
+}
 
 /// A material group a click can pick.
 #[derive(Clone, Debug, PartialEq)]
@@ -81,11 +99,56 @@ impl PickTable {
     }
 }
 
+/// A new goniometric light placed by a click (Grosch 2005 section 4.2): on the surface the
+/// probe sees along `towards`, moved off it along its normal.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlacedLight {
+    /// Its IES or EULUMDAT file.
+    pub file: PathBuf,
+    /// The direction clicked, probe frame (unit).
+    pub towards: Vec3,
+    /// Distance from the surface along its front normal, metres.
+    pub offset_m: f32,
+    /// The table's peak, probe units per sr (`peak_intensity` of an edits file).
+    pub peak_intensity: f32,
+}
+
 /// A request to the worker: the edits to show.
 #[derive(Clone, Debug, PartialEq)]
 struct EditRequest {
     materials: Vec<(String, Rgb)>,
+    lights: Vec<PlacedLight>,
     bounces: u32,
+}
+
+impl EditRequest {
+    /// Whether it changes nothing.
+    fn is_empty(&self) -> bool {
+        self.materials.is_empty() && self.lights.is_empty()
+    }
+}
+
+/// The edits file's form of a placed light: its world position from the room's geometry (the
+/// surface hit along the click's ray from the probe, moved along the surface's normal), aimed
+/// straight down, white.
+fn light_spec(room: &ibl_room::Room, light: &PlacedLight) -> Result<LightSpec, String> {
+    let direction = (room.world_from_probe * light.towards).normalize_or_zero();
+    let hit = room
+        .hit(room.probe_position, direction, 0.0, f32::INFINITY)
+        .ok_or_else(|| "the click meets no surface of the room".to_string())?;
+    let patch = &room.patches[hit.patch as usize];
+    let normal = if hit.front {
+        patch.normal
+    } else {
+        -patch.normal
+    };
+    Ok(LightSpec {
+        file: light.file.clone(),
+        position: room.probe_position + direction * hit.distance_m + normal * light.offset_m,
+        rotation_deg: [0.0; 3],
+        colour: Rgb::ONE,
+        scale: IntensityScale::PeakIntensity(light.peak_intensity),
+    })
 }
 
 /// The worker's answer.
@@ -120,9 +183,15 @@ fn answer(
         return Err("the room's estimate is missing".into());
     };
     let started = std::time::Instant::now();
+    let lights = request
+        .lights
+        .iter()
+        .map(|l| light_spec(&estimated.input.room, l))
+        .collect::<Result<Vec<_>, _>>()?;
     let edits = RoomEdits {
         bounces: request.bounces,
         materials: request.materials.clone(),
+        lights,
         source: room.to_path_buf(),
         ..RoomEdits::none()
     };
@@ -140,9 +209,11 @@ fn answer(
 /// What an edit did, one line for the panel.
 fn report_line(r: &EditReport) -> String {
     format!(
-        "{} group{} changed, {} bounce{} of colour bleeding (the last changed {:.2} %); edit {:.1} ms, panorama {:.1} ms",
+        "{} group{} changed, {} light{} added, {} bounce{} of colour bleeding (the last changed {:.2} %); edit {:.1} ms, panorama {:.1} ms",
         r.materials.len(),
         if r.materials.len() == 1 { "" } else { "s" },
+        r.lights.len(),
+        if r.lights.len() == 1 { "" } else { "s" },
         r.bounces,
         if r.bounces == 1 { "" } else { "s" },
         100.0 * r.last_bounce_relative,
@@ -205,6 +276,16 @@ pub struct RoomEditSession {
     pub picked_towards: Option<Vec3>,
     /// The new reflectances, by group name, in the order they were made.
     pub materials: Vec<(String, Rgb)>,
+    /// Whether a click on the panorama places a light (instead of picking).
+    pub placing: bool,
+    /// The lights placed.
+    pub lights: Vec<PlacedLight>,
+    /// The file, offset and peak the next light is placed with.
+    pub light_file: String,
+    /// See `light_file`.
+    pub light_offset_m: f32,
+    /// See `light_file`.
+    pub light_peak: f32,
     /// Bounces of colour bleeding.
     pub bounces: u32,
     /// Whether the edited panorama is shown (else the probe as it was).
@@ -234,6 +315,11 @@ impl RoomEditSession {
             picking: false,
             picked: None,
             picked_towards: None,
+            placing: false,
+            lights: Vec::new(),
+            light_file: default_light_file(room),
+            light_offset_m: DEFAULT_LIGHT_OFFSET_M,
+            light_peak: DEFAULT_LIGHT_PEAK,
             materials: Vec::new(),
             bounces: 1,
             show_edited: true,
@@ -285,7 +371,22 @@ impl RoomEditSession {
         }
     }
 
-    /// Picks the group seen along `direction` (probe frame) when picking is on.
+    /// What a click along `direction` (probe frame) does: places a light when placing is on,
+    /// else picks the group there when picking is on.
+    pub fn click(&mut self, direction: Vec3) {
+        if self.placing {
+            self.lights.push(PlacedLight {
+                file: PathBuf::from(self.light_file.trim()),
+                towards: direction,
+                offset_m: self.light_offset_m,
+                peak_intensity: self.light_peak,
+            });
+        } else if self.picking {
+            self.pick(direction);
+        }
+    }
+
+    /// Picks the group seen along `direction` (probe frame).
     pub fn pick(&mut self, direction: Vec3) {
         if let Some(table) = &self.table {
             self.picked = table.group_towards(direction);
@@ -297,6 +398,7 @@ impl RoomEditSession {
     fn current(&self) -> EditRequest {
         EditRequest {
             materials: self.materials.clone(),
+            lights: self.lights.clone(),
             bounces: self.bounces.clamp(1, MAX_BOUNCES),
         }
     }
@@ -329,7 +431,7 @@ impl RoomEditSession {
             }
         }
         let wanted = match &self.latest {
-            Some((n, _, request)) if self.show_edited && !request.materials.is_empty() => Some(*n),
+            Some((n, _, request)) if self.show_edited && !request.is_empty() => Some(*n),
             _ => None,
         };
         if wanted == self.displayed {
@@ -346,8 +448,7 @@ impl RoomEditSession {
     pub fn shows_current_edits(&self) -> bool {
         match &self.latest {
             Some((n, _, answered)) => {
-                *answered == self.current()
-                    && (self.displayed == Some(*n) || answered.materials.is_empty())
+                *answered == self.current() && (self.displayed == Some(*n) || answered.is_empty())
             }
             None => false,
         }

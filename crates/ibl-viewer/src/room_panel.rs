@@ -163,7 +163,13 @@ pub fn materials_section(
         return;
     };
     ui.horizontal(|ui| {
-        ui.checkbox(&mut session.picking, "click picks a surface");
+        if ui
+            .checkbox(&mut session.picking, "click picks a surface")
+            .changed()
+            && session.picking
+        {
+            session.placing = false;
+        }
         ui.checkbox(&mut session.show_edited, "show the edits");
     });
     ui.add(
@@ -202,11 +208,38 @@ pub fn materials_section(
     for (name, rho) in &session.materials {
         ui.label(format!("{name} -> {:.3} {:.3} {:.3}", rho.r, rho.g, rho.b));
     }
-    if !session.materials.is_empty() && ui.button("undo all").clicked() {
+    ui.separator();
+    ui.label("Lights (Grosch 4.2)");
+    if ui
+        .checkbox(&mut session.placing, "click places a light")
+        .on_hover_text("on the surface clicked, moved off it along its normal, aimed straight down")
+        .changed()
+        && session.placing
+    {
+        session.picking = false;
+    }
+    ui.horizontal(|ui| {
+        ui.label("IES / LDT file");
+        ui.text_edit_singleline(&mut session.light_file);
+    });
+    ui.add(
+        egui::Slider::new(&mut session.light_offset_m, 0.0..=1.5).text("metres off the surface"),
+    );
+    ui.add(
+        egui::Slider::new(&mut session.light_peak, 1.0..=400.0)
+            .logarithmic(true)
+            .text("peak, probe units / sr"),
+    );
+    for (k, l) in session.lights.iter().enumerate() {
+        ui.label(format!("light {}: {}", k + 1, l.file.display()));
+    }
+    let edited = !session.materials.is_empty() || !session.lights.is_empty();
+    if edited && ui.button("undo all").clicked() {
         session.materials.clear();
+        session.lights.clear();
     }
     match &session.last {
-        Some(Ok((line, _))) if !session.materials.is_empty() => {
+        Some(Ok((line, _))) if edited => {
             ui.label(line.as_str());
         }
         Some(Err(e)) => {

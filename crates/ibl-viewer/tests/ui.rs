@@ -263,15 +263,12 @@ fn an_outdoor_scene_plays_its_sequence_with_the_estimates_in_the_panel() {
     h.get_by_label("relit environment map (the sun left out)");
 }
 
-#[test]
-fn a_click_picks_the_floor_and_its_new_reflectance_edits_the_panorama() {
-    let Some(gpu) = common::gpu_or_skip("ui room materials") else {
-        return;
-    };
+/// The apartment looking straight down at the floor, with the room's editing switched on and
+/// its estimate made.
+fn editing_the_floor(gpu: &ibl_viewer::GpuContext) -> Harness<'static, ViewerApp> {
     let mut h = apartment_harness(
-        &gpu,
+        gpu,
         ProbeExtras {
-            // Looking straight down at the floor.
             pitch_deg: Some(-89.0),
             ..ProbeExtras::default()
         },
@@ -281,15 +278,29 @@ fn a_click_picks_the_floor_and_its_new_reflectance_edits_the_panorama() {
     step_until(&mut h, |app| {
         probe(app).edit.as_ref().is_some_and(|e| e.table.is_some())
     });
-    h.get_by_label("click picks a surface").click();
-    h.step();
-    // A click (press and release in place) at the middle of the view picks the floor.
+    h
+}
+
+/// A click (press and release in place) at the middle of the view.
+fn click_the_middle(h: &mut Harness<'static, ViewerApp>) {
     let middle = egui::pos2(305.0, 690.0);
     h.hover_at(middle);
     h.step();
     h.drag_at(middle);
     h.step();
     h.drop_at(middle);
+}
+
+#[test]
+fn a_click_picks_the_floor_and_its_new_reflectance_edits_the_panorama() {
+    let Some(gpu) = common::gpu_or_skip("ui room materials") else {
+        return;
+    };
+    let mut h = editing_the_floor(&gpu);
+    h.get_by_label("click picks a surface").click();
+    h.step();
+    // A click at the middle of the view picks the floor.
+    click_the_middle(&mut h);
     h.step();
     let (floor, before) = {
         let e = probe(h.state()).edit.as_ref().expect("editing");
@@ -341,4 +352,32 @@ fn a_click_picks_the_floor_and_its_new_reflectance_edits_the_panorama() {
     step_until(&mut h, |app| {
         std::sync::Arc::ptr_eq(&probe(app).model.latlong, &probe(app).original)
     });
+}
+
+#[test]
+fn a_click_places_a_light_and_its_pool_brightens_the_floor() {
+    let Some(gpu) = common::gpu_or_skip("ui room light") else {
+        return;
+    };
+    let mut h = editing_the_floor(&gpu);
+    h.get_by_label("click places a light").click();
+    h.step();
+    click_the_middle(&mut h);
+    step_until(&mut h, |app| {
+        probe(app)
+            .edit
+            .as_ref()
+            .is_some_and(|e| e.lights.len() == 1 && e.shows_current_edits())
+    });
+    let p = probe(h.state());
+    let e = p.edit.as_ref().expect("editing");
+    assert!(e.light_file.ends_with("umbrella.ies"), "{}", e.light_file);
+    // The light hangs 0.3 m above the clicked floor point, aimed down: the floor there is lit
+    // far more than by the room alone.
+    let d = e.lights[0].towards;
+    let (i, j) =
+        ibl_core::LatLong::new(p.original.width(), p.original.height()).dir_to_pixel(d.as_dvec3());
+    let (was, now) = (*p.original.get(i, j), *p.model.latlong.get(i, j));
+    assert!(now.g > 2.0 * was.g, "the pool: {now:?} against {was:?}");
+    h.get_by_label_contains("1 light added");
 }
