@@ -237,6 +237,17 @@ pub fn read_area_lights_file(path: &Path) -> Result<AreaLightsFile, IoError> {
     AreaLightsFile::from_json(path, &bytes)
 }
 
+/// The directional lights a scene's `[lighting] lights_file` gives: a light-set file as it is,
+/// an area-light file (`ibl room lights`) as its patches seen from the probe's centre
+/// ([`AreaLightsFile::distant_lights`]). Probe frame; the file's radiance unit.
+pub fn read_scene_lights(path: &Path) -> Result<LightSet, IoError> {
+    if is_area_lights_file(path)? {
+        Ok(read_area_lights_file(path)?.distant_lights())
+    } else {
+        crate::light_file::read_light_set(path)
+    }
+}
+
 /// Whether the file at `path` is an area-light file (its `format` field says so); reads at most
 /// [`MAX_AREA_LIGHTS_FILE_BYTES`].
 pub fn is_area_lights_file(path: &Path) -> Result<bool, IoError> {

@@ -80,12 +80,7 @@ impl LightingPlan {
     /// lights seen from the probe's centre (`AreaLightsFile::distant_lights`): the scene's origin
     /// stands where the probe stood in the room.
     pub fn with_light_file(self, path: &Path, radiance_scale: f32) -> Result<LightingPlan> {
-        let is_area = ibl_io::area_light_file::is_area_lights_file(path)?;
-        let set = if is_area {
-            ibl_io::area_light_file::read_area_lights_file(path)?.distant_lights()
-        } else {
-            ibl_io::light_file::read_light_set(path)?
-        };
+        let set = ibl_io::area_light_file::read_scene_lights(path)?;
         Ok(LightingPlan {
             given: Some(set.scaled(f64::from(radiance_scale))),
             ..self

@@ -45,7 +45,8 @@ pub struct SceneModel {
     load_placements: Vec<Affine3A>,
     /// Every file the scene read.
     pub inputs: Vec<PathBuf>,
-    /// The lights of the scene's `[lighting] lights_file`, probe frame, with the probe's
+    /// The lights of the scene's `[lighting] lights_file` (a light set, or an area-light file's
+    /// patches seen from the probe's centre), probe frame, with the probe's
     /// `radiance_scale` applied (the rule of `ibl_pipeline::lighting_plan`); read once at load.
     given_lights: Option<LightSet>,
 }
@@ -77,7 +78,7 @@ impl SceneModel {
         let geometry = SceneGeometry::from_scene(&loaded.scene);
         let given_lights = match &loaded.lights_path {
             Some(file) => Some(
-                ibl_io::light_file::read_light_set(file)?
+                ibl_io::area_light_file::read_scene_lights(file)?
                     .scaled(f64::from(loaded.description.probe.radiance_scale)),
             ),
             None => None,

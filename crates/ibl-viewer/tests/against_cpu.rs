@@ -1,4 +1,5 @@
-//! The viewer against the CPU renderer: every example scene, lights mode with hard shadows, the
+//! The viewer against the CPU renderer: every example scene and the room's important-patches
+//! scene (`assets/rooms/apartment/bunny-patches.toml`), lights mode with hard shadows, the
 //! same lights (`LightingPlan::build`, the call both make), the same camera and size. The viewer
 //! draws direct light only, so the CPU side renders one bounce (direct light) too.
 //!
@@ -23,11 +24,17 @@ const WIDTH: u32 = 320;
 const HEIGHT: u32 = 240;
 
 fn compare(name: &str) {
+    compare_file(
+        name,
+        &common::assets().join("scenes").join(format!("{name}.toml")),
+    );
+}
+
+fn compare_file(name: &str, path: &std::path::Path) {
     let Some(gpu) = common::gpu_or_skip(name) else {
         return;
     };
-    let path = common::assets().join("scenes").join(format!("{name}.toml"));
-    let mut model = SceneModel::open(&path).expect("the example scene opens");
+    let mut model = SceneModel::open(path).expect("the example scene opens");
     model.description.render.mode = RenderMode::Lights;
     model.description.lighting.shadows = ShadowKind::Hard;
     let options = HeadlessOptions {
@@ -79,4 +86,14 @@ fn bunny_sky_matches_the_cpu_lights_mode() {
 #[test]
 fn bunny_apartment_matches_the_cpu_lights_mode() {
     compare("bunny-apartment");
+}
+
+#[test]
+fn the_room_patches_scene_matches_the_cpu_lights_mode() {
+    // The bunny lit by the apartment's 32 important patches (Grosch 2005's improved display's
+    // lights, read from an area-light file as directional lights).
+    compare_file(
+        "bunny-patches",
+        &common::assets().join("rooms/apartment/bunny-patches.toml"),
+    );
 }
