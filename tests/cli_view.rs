@@ -595,3 +595,25 @@ fn a_bad_edits_file_in_the_viewer_is_refused_with_status_2() {
         "missing.toml",
     );
 }
+
+#[test]
+fn sky_lights_are_a_power_of_two_and_for_a_sequence_only() {
+    let courtyard = repo()
+        .join("assets/outdoor/courtyard/scene.toml")
+        .display()
+        .to_string();
+    refuses(
+        &["view", &courtyard, "--headless", "--sky-lights", "6"],
+        "power of two",
+    );
+    refuses(
+        &[
+            "view",
+            &scene("bunny-sky.toml"),
+            "--headless",
+            "--sky-lights",
+            "4",
+        ],
+        "outdoor sequence",
+    );
+}

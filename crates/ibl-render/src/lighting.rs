@@ -260,24 +260,33 @@ pub fn cap_zonal_factors(one_minus_c: f64, bands: usize) -> Vec<f64> {
 }
 
 fn light_list(scene: &Scene, set: &LightSet, shadows: ShadowKind) -> LightList {
-    let rotation: DMat3 = scene.probe.world_from_probe.as_dmat3();
-    let lights: Vec<DirectionalLight> = set
-        .lights
-        .iter()
-        .filter(|l| l.irradiance.any_positive())
-        .map(|l| {
-            let direction = (rotation * l.direction).normalize_or(DVec3::Y).as_vec3();
-            DirectionalLight {
-                direction,
-                irradiance: Rgb::new(
-                    l.irradiance.r as f32,
-                    l.irradiance.g as f32,
-                    l.irradiance.b as f32,
-                ),
-                cone: UniformCone::from_solid_angle(l.solid_angle_sr as f32),
-                frame: OrthonormalBasis::from_normal(direction),
-            }
-        })
-        .collect();
-    LightList { lights, shadows }
+    LightList::from_set(set, scene.probe.world_from_probe.as_dmat3(), shadows)
+}
+
+impl LightList {
+    /// The renderer's lights of `set` (its frame turned to the world by `world_from_set`): black
+    /// lights dropped, each with the cone of its solid angle `A_i` (soft shadows).
+    pub fn from_set(set: &LightSet, world_from_set: DMat3, shadows: ShadowKind) -> LightList {
+        let lights: Vec<DirectionalLight> = set
+            .lights
+            .iter()
+            .filter(|l| l.irradiance.any_positive())
+            .map(|l| {
+                let direction = (world_from_set * l.direction)
+                    .normalize_or(DVec3::Y)
+                    .as_vec3();
+                DirectionalLight {
+                    direction,
+                    irradiance: Rgb::new(
+                        l.irradiance.r as f32,
+                        l.irradiance.g as f32,
+                        l.irradiance.b as f32,
+                    ),
+                    cone: UniformCone::from_solid_angle(l.solid_angle_sr as f32),
+                    frame: OrthonormalBasis::from_normal(direction),
+                }
+            })
+            .collect();
+        LightList { lights, shadows }
+    }
 }

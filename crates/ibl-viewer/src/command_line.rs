@@ -164,6 +164,10 @@ pub struct ViewArgs {
     /// the edited panorama is shown instead of the probe.
     #[arg(long, value_name = "EDITS.toml", requires = "room")]
     pub edit: Option<PathBuf>,
+    /// An outdoor sequence's sky as N shadowed median-cut lights (a power of two; 0: the
+    /// unshadowed SH ambient): the objects' sky shadow, one shadow map per light.
+    #[arg(long, value_name = "N", default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=64))]
+    pub sky_lights: u32,
     /// Camera yaw over a probe, degrees (0 looks along -Z, positive looks left).
     #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
     pub yaw: Option<f32>,
@@ -282,6 +286,7 @@ pub fn run(args: &ViewArgs, progress: &dyn Progress) -> Result<Option<ViewSummar
             },
             background_rays: args.background_rays,
             display: None,
+            sky_lights: args.sky_lights as usize,
         },
         exposure_stops: args.exposure,
         curve: ToneCurve::from(args.tonemap),

@@ -56,6 +56,9 @@ pub struct HeadlessOptions {
     pub background_rays: u32,
     /// Exposure and curve; `None`: automatic from the probe, Reinhard (as `ibl render`).
     pub display: Option<Display>,
+    /// An outdoor sequence's sky as this many shadowed lights (0: the unshadowed ambient;
+    /// [`SequencePlayer::sky_lights`]).
+    pub sky_lights: usize,
 }
 
 impl Default for HeadlessOptions {
@@ -68,6 +71,7 @@ impl Default for HeadlessOptions {
             glossy: GlossySource::Lights,
             background_rays: 4,
             display: None,
+            sky_lights: 0,
         }
     }
 }
@@ -308,6 +312,7 @@ pub fn render_sequence(
     progress: &dyn Fn(usize, usize),
 ) -> Result<HeadlessRun, ViewerError> {
     let (w, h) = options.size;
+    player.sky_lights = options.sky_lights;
     let mut renderer = SceneRenderer::new(gpu, model, w, h, options.shadow_tile)?;
     let display = options.display.unwrap_or(Display {
         exposure_stops: auto_exposure(model),

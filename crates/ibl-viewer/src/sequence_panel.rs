@@ -1,5 +1,5 @@
 //! The "Sequence" section of the scene panel (Jensen, Andersen & Madsen 2006): play, pause, step
-//! and the rate; the frame shown with its local time and sky; the estimated sun `P_d` and sky
+//! and the rate; the sky as the ambient or as shadowed lights; the frame shown with its local time and sky; the estimated sun `P_d` and sky
 //! `P_a` (RGB, with their standard errors and the inliers of the robust fit); a chart of both
 //! (green channel) over the frames played; the relit map. The state is
 //! [`crate::sequence_state`]'s.
@@ -36,6 +36,19 @@ pub fn sequence_section(ui: &mut egui::Ui, sequence: &mut SequenceState) {
             .logarithmic(true)
             .text("frames per second"),
     );
+    egui::ComboBox::from_label("sky")
+        .selected_text(match sequence.sky_lights {
+            0 => "ambient (no sky shadows)".to_string(),
+            n => format!("{n} shadowed lights"),
+        })
+        .show_ui(ui, |ui| {
+            ui.selectable_value(&mut sequence.sky_lights, 0, "ambient (no sky shadows)");
+            for n in [4, 8, 16] {
+                ui.selectable_value(&mut sequence.sky_lights, n, format!("{n} shadowed lights"));
+            }
+        })
+        .response
+        .on_hover_text("the estimated sky split by median cut into lights with their own shadows: the objects' sky shadow, from the next frame");
     let count = sequence
         .frame_count()
         .map_or("a video".to_string(), |n| format!("{n} frames"));

@@ -14,30 +14,41 @@
 //!   design: the volume holds the sky as the buildings let it through and the light they
 //!   reflect); without one it is the tracked sky shape times `P_a` in SH, as the CPU composite's
 //!   ambient (`ibl_outdoor::composite::sky_ambient`), there seen through occlusion rays and here
-//!   unoccluded;
+//!   unoccluded; or, on request ([`SequencePlayer::sky_lights`]), the sky split by median cut
+//!   into N lights, each with its own shadow map (Madsen & Laursen 2006's lights applied to
+//!   the estimated sky): the objects' sky shadow on the ground and on themselves, which the
+//!   unshadowed ambient leaves out;
 //! - the **environment** mirrors and glossy lobes reflect: the relit map (the sun left out).
 //!
 //! Shadows both ways come from the scene pass's differential composite with the model as the
 //! real layer: a real surface the buildings already shade has no sun in either pass, so the
 //! object casts no second sun shadow there (the paper's rule, by construction).
 //!
-//! What the viewer leaves out that the CPU composite has: the objects' occlusion of the ambient
-//! (their sky shadow on the ground and on themselves) and the sun's penumbra beyond the shadow
-//! map's filter. `tests/sequence.rs` measures the difference on the bundled courtyard.
+//! What the viewer leaves out that the CPU composite has: with the ambient, the objects'
+//! occlusion of it (their sky shadow on the ground and on themselves; the sky lights bring it
+//! back as N shadows), and the sun's penumbra beyond the shadow map's filter. `tests/sequence.rs` measures the difference on the bundled courtyard.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use glam::Vec3;
+use glam::{DMat3, Mat3, Vec3};
 use ibl_core::{Image, LatLong, Rgb};
+use ibl_extract::{ExtractOptions, ModelSpec, build_model};
+use ibl_light::Method;
 use ibl_outdoor::composite::{sky_ambient, sun_light};
 use ibl_outdoor::{CompositeSettings, FrameResult, OutdoorSystem};
 use ibl_pipeline::outdoor_sequence::OutdoorSequence;
+use ibl_render::lighting::LightList;
+use ibl_scene::ShadowKind;
 use ibl_sh::{LeakControl, VolumeLayer};
 use serde::Serialize;
 
 use crate::ViewerError;
 use crate::lighting::{IRRADIANCE_MAP_WIDTH, SceneLighting, irradiance_map};
+
+/// Lat-long size the sky is split into lights from (median cut needs no more: each light is a
+/// region of it).
+const SKY_MAP_SIZE: (usize, usize) = (128, 64);
 
 /// One played frame: which it was and what was estimated.
 #[derive(Clone, Debug, Serialize)]
@@ -77,6 +88,10 @@ pub struct SequencePlayer {
     /// Where the ambient is read from the volume: the objects' bounding-sphere centre.
     ambient_point: Option<Vec3>,
     ambient_bands: usize,
+    /// The sky as this many shadowed lights (median cut of the sky, Madsen & Laursen 2006)
+    /// instead of the unshadowed ambient: the objects' sky shadow on the ground and on
+    /// themselves, at the cost of a shadow map per light; 0 keeps the ambient.
+    pub sky_lights: usize,
     /// Seconds the offline step took.
     pub setup_seconds: f64,
     /// Frames in the sequence (`None` for a video).
@@ -105,6 +120,7 @@ impl PreparedSequence {
             setup_seconds: started.elapsed().as_secs_f64(),
             ambient_point: self.objects_centre,
             ambient_bands: CompositeSettings::default().ambient_bands,
+            sky_lights: 0,
             sequence: self.sequence,
             system,
         })
@@ -202,7 +218,22 @@ impl SequencePlayer {
     /// The renderer's lights for a frame's result (module notes).
     fn lighting(&self, result: &FrameResult) -> Result<SceneLighting, ViewerError> {
         let numerical = |e: String| ViewerError::Lighting(e);
-        let lights: Vec<_> = sun_light(&result.sun).into_iter().collect();
+        let mut lights: Vec<_> = sun_light(&result.sun).into_iter().collect();
+        let sun = if lights.is_empty() { "no sun" } else { "sun" };
+        let sky = format!("{:?}", result.sky_condition).to_lowercase();
+        if self.sky_lights > 0 {
+            let set = self.sky_light_set(result)?;
+            let list = LightList::from_set(&set, DMat3::IDENTITY, ShadowKind::Soft);
+            lights.extend(list.lights);
+            return Ok(SceneLighting {
+                lights,
+                ambient: None,
+                summary: format!(
+                    "{sun} + the sky as {} shadowed median-cut lights, {sky} sky",
+                    self.sky_lights
+                ),
+            });
+        }
         let volume_ambient = match (self.system.volume(), self.ambient_point) {
             (Some(volume), Some(point)) => volume
                 .sample(point, VolumeLayer::AllLight, LeakControl::ValidOnly)
@@ -233,14 +264,31 @@ impl SequencePlayer {
                 )
             }
         };
-        let sun = if lights.is_empty() { "no sun" } else { "sun" };
         Ok(SceneLighting {
             lights,
             ambient: Some(ambient),
-            summary: format!(
-                "{sun} + {source}, {} sky",
-                format!("{:?}", result.sky_condition).to_lowercase()
-            ),
+            summary: format!("{sun} + {source}, {sky} sky"),
         })
+    }
+
+    /// The frame's sky (the tracked shape times `P_a`, world frame, the sun left out) as
+    /// [`SequencePlayer::sky_lights`] median-cut lights (their irradiance sums to the sky's).
+    fn sky_light_set(&self, result: &FrameResult) -> Result<ibl_light::LightSet, ViewerError> {
+        let lighting = self
+            .system
+            .frame_lighting(result)
+            .map_err(|e| ViewerError::Lighting(e.to_string()))?;
+        let (w, h) = SKY_MAP_SIZE;
+        let mut map = lighting.sky_shape.latlong(w, h, Mat3::IDENTITY);
+        for px in map.pixels_mut() {
+            *px = *px * lighting.sky;
+        }
+        let spec = ModelSpec::from(Method::MedianCut);
+        let (model, _) = build_model(&map, spec, self.sky_lights, &ExtractOptions::default())
+            .map_err(|e| ViewerError::Parameter(format!("sky lights: {e}")))?;
+        model
+            .lights()
+            .cloned()
+            .ok_or_else(|| ViewerError::Lighting("median cut made no sky lights".into()))
     }
 }

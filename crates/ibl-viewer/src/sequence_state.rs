@@ -37,8 +37,9 @@ struct WorkerFrame {
     setup_seconds: Option<f64>,
 }
 
-/// The next frame of the player in `slot` (the offline step first, once).
-fn play_next(slot: &Mutex<PlayerSlot>) -> Result<WorkerFrame, String> {
+/// The next frame of the player in `slot` (the offline step first, once), its sky as
+/// `sky_lights` shadowed lights (0: the ambient).
+fn play_next(slot: &Mutex<PlayerSlot>, sky_lights: usize) -> Result<WorkerFrame, String> {
     let mut slot = slot.lock().unwrap_or_else(PoisonError::into_inner);
     let mut setup_seconds = None;
     if let PlayerSlot::Prepared(_) = &*slot {
@@ -52,6 +53,7 @@ fn play_next(slot: &Mutex<PlayerSlot>) -> Result<WorkerFrame, String> {
     }
     match &mut *slot {
         PlayerSlot::Playing(player) => {
+            player.sky_lights = sky_lights;
             let step = player.step().map_err(|e| e.to_string())?;
             Ok(WorkerFrame {
                 step,
@@ -70,7 +72,7 @@ pub const DEFAULT_RATE: f32 = 2.0;
 
 /// A sequence being played in the window.
 pub struct SequenceState {
-    worker: LatestWorker<(), Result<WorkerFrame, String>>,
+    worker: LatestWorker<usize, Result<WorkerFrame, String>>,
     frame_count: Option<usize>,
     /// Whether frames advance by themselves.
     pub playing: bool,
@@ -87,6 +89,8 @@ pub struct SequenceState {
     pub relit_texture: Option<egui::TextureHandle>,
     /// Seconds the offline step took (once it ran).
     pub setup_seconds: Option<f64>,
+    /// The sky as this many shadowed lights from the next frame on (0: the ambient).
+    pub sky_lights: usize,
 }
 
 impl SequenceState {
@@ -101,7 +105,9 @@ impl SequenceState {
         let frame_count = prepared.frame_count();
         let slot = Mutex::new(PlayerSlot::Prepared(Box::new(prepared)));
         Ok(Some(SequenceState {
-            worker: LatestWorker::new("ibl-view sequence", move |()| play_next(&slot)),
+            worker: LatestWorker::new("ibl-view sequence", move |sky_lights| {
+                play_next(&slot, sky_lights)
+            }),
             frame_count,
             playing: true,
             rate: DEFAULT_RATE,
@@ -111,6 +117,7 @@ impl SequenceState {
             relit_pending: None,
             relit_texture: None,
             setup_seconds: None,
+            sky_lights: 0,
         }))
     }
 
@@ -152,7 +159,7 @@ impl SequenceState {
         if !self.worker.busy() && self.due(now) {
             self.step_requested = false;
             self.last_step = Some(now);
-            self.worker.submit(());
+            self.worker.submit(self.sky_lights);
         }
         let Some(done) = self.worker.poll() else {
             return Ok(());

@@ -271,6 +271,24 @@ fn check_bands(bands: u32) -> Result<usize, ViewerError> {
     }
 }
 
+/// `--sky-lights N`: a power of two (median cut), for a sequence only.
+fn check_sky_lights(n: usize, sequence: bool) -> Result<(), ViewerError> {
+    if n == 0 {
+        return Ok(());
+    }
+    if !sequence {
+        return Err(ViewerError::Parameter(
+            "--sky-lights applies to an outdoor sequence (a scene with an [outdoor] table)".into(),
+        ));
+    }
+    if !n.is_power_of_two() {
+        return Err(ViewerError::Parameter(format!(
+            "--sky-lights {n}: the sky is split by median cut, which makes a power of two lights"
+        )));
+    }
+    Ok(())
+}
+
 fn check_outputs(
     outputs: Option<&(PathBuf, PathBuf)>,
     inputs: &[PathBuf],
@@ -371,7 +389,9 @@ impl ViewJob {
             self.apply_scene_overrides(&mut model)?;
             check_outputs(outputs.as_ref(), &model.inputs)?;
             options.display = Some(self.display(headless::auto_exposure(&model))?);
-            if SequencePlayer::is_sequence(&model.description) {
+            let sequence = SequencePlayer::is_sequence(&model.description);
+            check_sky_lights(options.sky_lights, sequence)?;
+            if sequence {
                 options.motion = Motion::Sequence;
                 let centre = model.objects_sphere().map(|(c, _)| c);
                 progress.begin("sequence: offline maps and sample sites", 0);

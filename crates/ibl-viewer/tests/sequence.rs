@@ -74,8 +74,9 @@ fn the_sequence_plays_the_estimates_of_ibl_outdoor() {
     }
 }
 
-/// The viewer's frame `index` of the courtyard against the CPU composite of the same frame.
-fn compare_frame(index: usize, label: &str) {
+/// The viewer's frame `index` of the courtyard (its sky as `sky_lights` shadowed lights, or the
+/// ambient for 0) against the CPU composite of the same frame.
+fn compare_frame(index: usize, label: &str, sky_lights: usize) {
     let Some(gpu) = common::gpu_or_skip(label) else {
         return;
     };
@@ -117,6 +118,7 @@ fn compare_frame(index: usize, label: &str) {
     let options = HeadlessOptions {
         size: (w, h),
         frames: index as u32 + 1,
+        sky_lights,
         ..Default::default()
     };
     let run = headless::render_sequence(&gpu, &model, &mut player, &options, &|_, _| {})
@@ -126,7 +128,7 @@ fn compare_frame(index: usize, label: &str) {
     let (outcome, masks_equal) =
         common::against_cpu(&format!("viewer-sequence-{label}"), &run.images, &cpu, 0.05);
     eprintln!(
-        "courtyard frame {index} ({label}): {outcome:?}, coverage masks equal on {:.3} %",
+        "courtyard frame {index} ({label}, {sky_lights} sky lights): {outcome:?}, coverage masks equal on {:.3} %",
         100.0 * masks_equal
     );
     if let Err(e) = outcome {
@@ -141,13 +143,20 @@ fn compare_frame(index: usize, label: &str) {
 #[test]
 fn a_clear_frame_matches_the_cpu_composite() {
     // 10:00, clear: the objects sunlit, their sun shadow on the paving.
-    compare_frame(0, "clear");
+    compare_frame(0, "clear", 0);
 }
 
 #[test]
 fn an_overcast_frame_matches_the_cpu_composite() {
     // 14:00, overcast: no sun shadow, only the sky's.
-    compare_frame(4, "overcast");
+    compare_frame(4, "overcast", 0);
+}
+
+#[test]
+fn an_overcast_frame_with_the_sky_as_shadowed_lights_matches_the_cpu_composite() {
+    // 14:00, overcast, the sky as 8 median-cut lights with their shadows: the statue's sky
+    // shadow, which the unshadowed ambient leaves out.
+    compare_frame(4, "overcast-sky-lights", 8);
 }
 
 #[test]
