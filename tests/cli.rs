@@ -366,11 +366,17 @@ fn check_demo(
         assert!(out_dir.join(&png).exists(), "{}", png.display());
     }
     assert!(out_dir.join("outdoor/estimates.svg").exists());
-    // The viewer's section (issue 15): a headless frame of each example scene with its timings;
-    // without a GPU adapter it says so, which only a machine outside CI may lack.
+    // The viewer's section (issue 15): a headless frame of each example scene with its timings,
+    // and the outdoor sequence played (issue 18); without a GPU adapter it says so, which only
+    // a machine outside CI may lack.
     let viewer = sections.iter().find(|s| s["id"] == "viewer").unwrap();
     let frames = viewer["data"].as_array().unwrap();
-    assert_eq!(frames.len(), scene_count);
+    assert_eq!(frames.len(), scene_count + 1);
+    let sequence = frames.last().unwrap();
+    assert_eq!(sequence["scene"], "outdoor-courtyard");
+    if let Some(played) = sequence["summary"]["sequence"]["frames"].as_array() {
+        assert_eq!(played.len(), 3, "the demo plays three sequence frames");
+    }
     for f in frames {
         if let Some(png) = f["frame"].as_str() {
             assert!(out_dir.join(png).exists(), "{png}");

@@ -161,7 +161,7 @@ pub fn demo(
     sections.extend(
         front_ends
             .iter()
-            .map(|f| f.section(&o.scenes, &o.out, progress)),
+            .map(|f| f.section(&o.scenes, o.outdoor.as_deref(), &o.out, progress)),
     );
     crate::demo_page::write_summary(
         &o.out,

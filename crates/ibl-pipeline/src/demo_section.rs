@@ -25,7 +25,14 @@ pub struct PageSection {
 /// A front end's part of the demo. It never fails the demo: what it could not make (no GPU
 /// adapter, say) it reports in its section.
 pub trait DemoSection {
-    /// Makes the section from the demo's scene files in `scenes`, writing its files under the
-    /// demo's output folder `out`.
-    fn section(&self, scenes: &Path, out: &Path, progress: &dyn Progress) -> PageSection;
+    /// Makes the section from the demo's scene files in `scenes` and its outdoor sequence
+    /// `outdoor` (a scene with an `[outdoor]` table, when the demo runs one), writing its files
+    /// under the demo's output folder `out`.
+    fn section(
+        &self,
+        scenes: &Path,
+        outdoor: Option<&Path>,
+        out: &Path,
+        progress: &dyn Progress,
+    ) -> PageSection;
 }

@@ -66,8 +66,20 @@ fn caption(name: &str, s: &ViewSummary) -> String {
                 .join(", ")
         })
         .unwrap_or_else(|| "no GPU timestamps".into());
+    let played = s
+        .sequence
+        .as_ref()
+        .and_then(|q| q.frames.last())
+        .map(|f| {
+            let e = &f.result.estimate;
+            format!(
+                "; sequence frame {} at {}: sun P_d {:.3?}, sky P_a {:.3?}",
+                f.name, f.local_time, e.sun, e.sky
+            )
+        })
+        .unwrap_or_default();
     format!(
-        "{name}: {} at {} x {}, {:.2} fps median ({:.1} ms a frame; last frame: {passes}) on {} ({})",
+        "{name}: {} at {} x {}, {:.2} fps median ({:.1} ms a frame; last frame: {passes}) on {} ({}){played}",
         s.lighting,
         s.width,
         s.height,
@@ -79,11 +91,19 @@ fn caption(name: &str, s: &ViewSummary) -> String {
 }
 
 impl DemoSection for ViewerFrames {
-    fn section(&self, scenes: &Path, out: &Path, progress: &dyn Progress) -> PageSection {
+    fn section(
+        &self,
+        scenes: &Path,
+        outdoor: Option<&Path>,
+        out: &Path,
+        progress: &dyn Progress,
+    ) -> PageSection {
         let mut html = String::from(
             "<p>Each example scene as the real-time viewer draws it: one headless frame of \
              <code>ibl view SCENE --headless</code> (the same code as the window), its lights \
-             each with a shadow map, composited into the probe on the GPU.</p>",
+             each with a shadow map, composited into the probe on the GPU; and the outdoor \
+             sequence played by the viewer (its third frame: each frame's sun and sky \
+             estimated as <code>ibl outdoor</code> does, the sun with its shadow).</p>",
         );
         let mut data = Vec::new();
         // The scenes the demo rendered, so the two sections show the same ones.
@@ -99,11 +119,19 @@ impl DemoSection for ViewerFrames {
             let _ = write!(html, "<p>No frames: {e}</p>");
             files.clear();
         }
-        for scene in &files {
-            let name = scene
-                .file_stem()
+        let stem = |p: &Path| {
+            p.file_stem()
                 .map(|s| s.to_string_lossy().into_owned())
-                .unwrap_or_default();
+                .unwrap_or_default()
+        };
+        let mut named: Vec<(String, PathBuf)> =
+            files.iter().map(|p| (stem(p), p.clone())).collect();
+        // The sequence is named after its folder (its file is `scene.toml`).
+        if let Some(o) = outdoor {
+            let folder = o.parent().map_or_else(|| stem(o), stem);
+            named.push((format!("outdoor-{folder}"), o.to_path_buf()));
+        }
+        for (name, scene) in &named {
             let png = format!("{VIEWER_DIR}/{name}.png");
             match job(scene, out.join(&png)).run(progress) {
                 Ok(summary) => {
@@ -111,7 +139,7 @@ impl DemoSection for ViewerFrames {
                         html,
                         "<figure><a href=\"{png}\"><img class=wide src=\"{png}\"></a>\
                          <figcaption>{}</figcaption></figure>",
-                        caption(&name, &summary)
+                        caption(name, &summary)
                     );
                     data.push(
                         serde_json::json!({ "scene": name, "frame": png, "summary": summary }),
