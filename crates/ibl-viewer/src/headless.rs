@@ -126,7 +126,8 @@ pub struct HeadlessRun {
     pub lights: usize,
     /// Their description.
     pub lighting: String,
-    /// Seconds spent making the lights (before the first frame).
+    /// Seconds spent making the lights (before the first frame; a sequence: the mean per
+    /// frame, each frame making its own).
     pub lighting_seconds: f64,
     /// Shadow map side per light, texels.
     pub shadow_tile: u32,
