@@ -186,6 +186,37 @@ pub struct ObjectPicture {
     pub coverage: Image<f32>,
 }
 
+impl ObjectPicture {
+    /// A `w x h` picture of `n x n` rays per pixel: `ray(i, j, a, b, unimportant)` is pixel
+    /// `(i, j)`'s ray `(a, b)`, its radiance and whether it met an object (`None`: black, no
+    /// object); `unimportant` is the cache of the unimportant shadow the pixel's rays share.
+    fn supersampled(
+        w: usize,
+        h: usize,
+        n: u32,
+        ray: impl Fn(usize, usize, u32, u32, &mut Option<Rgb>) -> Option<(Rgb, bool)> + Sync,
+    ) -> ObjectPicture {
+        let pixels = Image::from_fn_par(w, h, |i, j| {
+            let (mut sum, mut hits) = (Rgb::ZERO, 0u32);
+            let mut unimportant = None;
+            for b in 0..n {
+                for a in 0..n {
+                    if let Some((l, object)) = ray(i, j, a, b, &mut unimportant) {
+                        sum += l;
+                        hits += u32::from(object);
+                    }
+                }
+            }
+            let k = (n * n) as f32;
+            (sum / k, hits as f32 / k)
+        });
+        ObjectPicture {
+            image: pixels.map(|p| p.0),
+            coverage: pixels.map(|p| p.1),
+        }
+    }
+}
+
 impl<'a> ObjectDisplay<'a> {
     /// The objects `objects` in the room of `radiance` (its probe texture and estimate), lit by
     /// `volume` (built for the same room with `important`'s patches) and `important`'s patches;
@@ -594,29 +625,17 @@ impl<'a> ObjectDisplay<'a> {
             )));
         }
         let n = self.settings.samples_per_axis;
-        let pixels = Image::from_fn_par(w, h, |i, j| {
-            let (mut sum, mut hits) = (Rgb::ZERO, 0u32);
-            let mut unimportant = None;
-            for b in 0..n {
-                for a in 0..n {
-                    let x = i as f32 + (a as f32 + 0.5) / n as f32;
-                    let y = j as f32 + (b as f32 + 0.5) / n as f32;
-                    let ray = camera.ray(x, y, width, height);
-                    if let Some((l, object)) =
-                        self.trace(ray.origin, ray.direction, None, fill, &mut unimportant)
-                    {
-                        sum += l;
-                        hits += u32::from(object);
-                    }
-                }
-            }
-            let k = (n * n) as f32;
-            (sum / k, hits as f32 / k)
-        });
-        Ok(ObjectPicture {
-            image: pixels.map(|p| p.0),
-            coverage: pixels.map(|p| p.1),
-        })
+        Ok(ObjectPicture::supersampled(
+            w,
+            h,
+            n,
+            |i, j, a, b, unimportant| {
+                let x = i as f32 + (a as f32 + 0.5) / n as f32;
+                let y = j as f32 + (b as f32 + 0.5) / n as f32;
+                let ray = camera.ray(x, y, width, height);
+                self.trace(ray.origin, ray.direction, None, fill, unimportant)
+            },
+        ))
     }
 
     /// The probe (`probe`, lat-long, its pixels the room as the probe saw it) re-rendered with
@@ -627,35 +646,25 @@ impl<'a> ObjectDisplay<'a> {
             return Err(RoomError::Parameter("the probe is empty".into()));
         }
         let n = self.settings.samples_per_axis;
-        let pixels = Image::from_fn_par(w, h, |i, j| {
-            let observed = *probe.get(i, j);
-            let (mut sum, mut hits) = (Rgb::ZERO, 0u32);
-            let mut unimportant = None;
-            for b in 0..n {
-                for a in 0..n {
-                    let u = (i as f64 + (f64::from(a) + 0.5) / f64::from(n)) / w as f64;
-                    let v = (j as f64 + (f64::from(b) + 0.5) / f64::from(n)) / h as f64;
-                    let d = self.room.world_from_probe * LatLong::uv_to_dir(u, v);
-                    let (l, object) = self
-                        .trace(
-                            self.room.probe_position,
-                            d.normalize(),
-                            Some(observed),
-                            HoleFill::Estimate,
-                            &mut unimportant,
-                        )
-                        .unwrap_or((observed, false));
-                    sum += l;
-                    hits += u32::from(object);
-                }
-            }
-            let k = (n * n) as f32;
-            (sum / k, hits as f32 / k)
-        });
-        Ok(ObjectPicture {
-            image: pixels.map(|p| p.0),
-            coverage: pixels.map(|p| p.1),
-        })
+        Ok(ObjectPicture::supersampled(
+            w,
+            h,
+            n,
+            |i, j, a, b, unimportant| {
+                let observed = *probe.get(i, j);
+                let u = (i as f64 + (f64::from(a) + 0.5) / f64::from(n)) / w as f64;
+                let v = (j as f64 + (f64::from(b) + 0.5) / f64::from(n)) / h as f64;
+                let d = self.room.world_from_probe * LatLong::uv_to_dir(u, v);
+                let traced = self.trace(
+                    self.room.probe_position,
+                    d.normalize(),
+                    Some(observed),
+                    HoleFill::Estimate,
+                    unimportant,
+                );
+                Some(traced.unwrap_or((observed, false)))
+            },
+        ))
     }
 }
 
