@@ -319,7 +319,6 @@ pub fn render_sequence(
         exposure_stops: auto_exposure(model),
         ..Display::default()
     });
-    let reflects = model.reflects_environment();
     let settings = SceneFrameSettings {
         camera: scene_camera(model, w, h),
         display,
@@ -338,16 +337,12 @@ pub fn render_sequence(
         let step = player.step()?;
         summary = step.lighting.summary.clone();
         let cpu_started = Instant::now();
-        renderer.set_photo(gpu, model, step.image);
-        renderer.set_lighting(gpu, step.lighting);
-        if reflects {
-            renderer.set_environment(gpu, player.relit_map());
-        }
+        let frame = step.show(gpu, model, &mut renderer, player.relit_map());
         let upload_seconds = cpu_started.elapsed().as_secs_f64();
         let report = renderer.render(gpu, model, &settings);
         finish(gpu)?;
         let wall_seconds = started.elapsed().as_secs_f64();
-        let f = &step.frame;
+        let f = &frame;
         lighting_seconds += f.lighting_seconds;
         let before = f.read_seconds + f.estimate_seconds + f.lighting_seconds + upload_seconds;
         timings.push(scene_frame_timing(
@@ -357,7 +352,7 @@ pub fn render_sequence(
             before,
             wall_seconds,
         ));
-        played.push(step.frame);
+        played.push(frame);
         progress(k + 1, frames);
     }
     let images = renderer.targets().read_back(gpu)?;

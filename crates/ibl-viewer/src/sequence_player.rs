@@ -44,7 +44,10 @@ use ibl_sh::{LeakControl, VolumeLayer};
 use serde::Serialize;
 
 use crate::ViewerError;
+use crate::gpu::GpuContext;
 use crate::lighting::{IRRADIANCE_MAP_WIDTH, SceneLighting, irradiance_map};
+use crate::scene_model::SceneModel;
+use crate::scene_renderer::SceneRenderer;
 
 /// Lat-long size the sky is split into lights from (median cut needs no more: each light is a
 /// region of it).
@@ -79,6 +82,26 @@ pub struct SequenceStep {
     pub image: Image<Rgb>,
     /// The sun and the ambient.
     pub lighting: SceneLighting,
+}
+
+impl SequenceStep {
+    /// Hands the step to `renderer` (module notes): its image as the photo background, its sun
+    /// and ambient as the lights, and `relit` (the relit map after it) as the environment when
+    /// an object of `model` reflects it; returns the frame played.
+    pub fn show(
+        self,
+        gpu: &GpuContext,
+        model: &SceneModel,
+        renderer: &mut SceneRenderer,
+        relit: &Image<Rgb>,
+    ) -> PlayedFrame {
+        renderer.set_photo(gpu, model, self.image);
+        renderer.set_lighting(gpu, self.lighting);
+        if model.reflects_environment() {
+            renderer.set_environment(gpu, relit);
+        }
+        self.frame
+    }
 }
 
 /// An outdoor sequence being played (see the module notes).

@@ -168,12 +168,7 @@ impl SequenceState {
         if frame.setup_seconds.is_some() {
             self.setup_seconds = frame.setup_seconds;
         }
-        let step = frame.step;
-        renderer.set_photo(gpu, model, step.image);
-        renderer.set_lighting(gpu, step.lighting);
-        if model.reflects_environment() {
-            renderer.set_environment(gpu, &frame.relit);
-        }
+        let played = frame.step.show(gpu, model, renderer, &frame.relit);
         let relit = to_srgb8(&frame.relit, display);
         let rgb: Vec<u8> = relit.pixels().iter().flatten().copied().collect();
         self.relit_pending = Some(egui::ColorImage::from_rgb(
@@ -183,7 +178,7 @@ impl SequenceState {
         if self.history.len() == MAX_HISTORY {
             self.history.remove(0);
         }
-        self.history.push(step.frame);
+        self.history.push(played);
         Ok(())
     }
 
