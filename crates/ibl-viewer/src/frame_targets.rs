@@ -1,10 +1,12 @@
 //! The textures one frame is drawn into, at the output size, and reading them back.
 //!
-//! - `msaa_radiance`, `msaa_coverage`, `msaa_depth`: the scene pass, 4 samples per pixel. The
-//!   radiance target resolves (averages its samples) into `radiance`, which is what differential
-//!   rendering wants: the CPU renderer averages its sample composites the same way, so an edge
-//!   pixel mixes object and background by the fraction of samples the object covers.
-//!   `coverage` holds that fraction (1 on a virtual object, 0 elsewhere, averaged).
+//! - `gbuffer_depth`, `gbuffer_id`, `gbuffer_normals`, `msaa_depth`: the scene's geometry pass,
+//!   4 samples per pixel (`scene_pass.wgsl`): what shading needs of the surface each sample
+//!   sees. The shading pass averages the samples' composites into `radiance`, which is what
+//!   differential rendering wants: the CPU renderer averages its sample composites the same way,
+//!   so an edge pixel mixes object and background by the fraction of samples the object covers.
+//!   `coverage` holds that fraction.
+//! - `light_masks`: the lights each screen tile's real surfaces need (`light_tiles.rs`).
 //! - `radiance`: linear radiance (`Rgba16Float`), the frame an EXR is written from.
 //! - `overlay`: premultiplied display-space colour drawn over the picture (selection, regions).
 //! - `display`: the tone-mapped sRGB picture (`Rgba8Unorm`), what the window shows and a PNG
@@ -20,6 +22,14 @@ use crate::textures::padded_bytes_per_row;
 pub const MSAA_SAMPLES: u32 = 4;
 /// Format of the object-coverage target.
 pub const COVERAGE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R8Unorm;
+/// Formats of the geometry pass's targets: view depth and surface id (one 32-bit float each),
+/// the octahedral shading and geometric normals (`Rgba16Float`, about 1e-3 rad). Formats every
+/// device can multisample, 16 bytes a sample in all.
+pub const GBUFFER_FORMATS: [wgpu::TextureFormat; 3] = [
+    wgpu::TextureFormat::R32Float,
+    wgpu::TextureFormat::R32Float,
+    wgpu::TextureFormat::Rgba16Float,
+];
 /// Format of the overlay target.
 pub const OVERLAY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 
@@ -31,17 +41,17 @@ pub const MAX_OUTPUT_SIDE: u32 = 8192;
 pub struct FrameTargets {
     /// Width and height, pixels.
     pub size: (u32, u32),
-    /// Multisampled radiance of the scene pass.
-    pub msaa_radiance: wgpu::TextureView,
-    /// Multisampled object coverage.
-    pub msaa_coverage: wgpu::TextureView,
+    /// The geometry pass's view depth, surface ids and normals ([`GBUFFER_FORMATS`]).
+    pub gbuffer: [wgpu::TextureView; 3],
     /// Multisampled depth (reversed: 1 near, 0 far).
     pub msaa_depth: wgpu::TextureView,
-    /// Resolved radiance.
+    /// Per 8 x 8 pixel tile, the lights that can change its real surfaces (`light_tiles.rs`).
+    pub light_masks: wgpu::Buffer,
+    /// Radiance, the mean of the samples' composites.
     pub radiance: wgpu::Texture,
     /// View of `radiance`.
     pub radiance_view: wgpu::TextureView,
-    /// Resolved object coverage.
+    /// Object coverage.
     pub coverage: wgpu::Texture,
     /// View of `coverage`.
     pub coverage_view: wgpu::TextureView,
@@ -102,25 +112,34 @@ impl FrameTargets {
         let sampled = attach | wgpu::TextureUsages::TEXTURE_BINDING;
         let readable = sampled | wgpu::TextureUsages::COPY_SRC;
         let view = |t: &wgpu::Texture| t.create_view(&wgpu::TextureViewDescriptor::default());
-        let msaa_radiance = texture(gpu, "msaa radiance", size, HDR_FORMAT, MSAA_SAMPLES, attach);
-        let msaa_coverage = texture(
-            gpu,
-            "msaa coverage",
-            size,
-            COVERAGE_FORMAT,
-            MSAA_SAMPLES,
-            attach,
-        );
+        let labels = ["gbuffer depth", "gbuffer id", "gbuffer normals"];
+        let gbuffer = std::array::from_fn(|k| {
+            let format = GBUFFER_FORMATS[k];
+            view(&texture(
+                gpu,
+                labels[k],
+                size,
+                format,
+                MSAA_SAMPLES,
+                sampled,
+            ))
+        });
         let msaa_depth = texture(gpu, "msaa depth", size, DEPTH_FORMAT, MSAA_SAMPLES, attach);
+        let light_masks = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("light masks"),
+            size: crate::light_tiles::mask_bytes(size),
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        });
         let radiance = texture(gpu, "radiance", size, HDR_FORMAT, 1, readable);
         let coverage = texture(gpu, "coverage", size, COVERAGE_FORMAT, 1, readable);
         let overlay = texture(gpu, "overlay", size, OVERLAY_FORMAT, 1, sampled);
         let display = texture(gpu, "display", size, DISPLAY_FORMAT, 1, readable);
         Ok(FrameTargets {
             size,
-            msaa_radiance: view(&msaa_radiance),
-            msaa_coverage: view(&msaa_coverage),
+            gbuffer,
             msaa_depth: view(&msaa_depth),
+            light_masks,
             radiance_view: view(&radiance),
             radiance,
             coverage_view: view(&coverage),
@@ -131,7 +150,7 @@ impl FrameTargets {
         })
     }
 
-    /// Copies the resolved radiance, the coverage and the picture to the CPU (waits for the GPU).
+    /// Copies the radiance, the coverage and the picture to the CPU (waits for the GPU).
     pub fn read_back(&self, gpu: &GpuContext) -> Result<FrameImages, ViewerError> {
         let (w, h) = self.size;
         let radiance = read_texture(gpu, &self.radiance, 8)?;

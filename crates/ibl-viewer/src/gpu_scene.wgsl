@@ -68,3 +68,12 @@ struct Vertex {
     @location(1) normal: vec3<f32>,
     @location(2) material: u32,
 };
+
+// The world point at view depth `depth` (distance in front of the camera along its axis) seen
+// through continuous pixel coordinates `pixel`: camera_ray's unnormalised direction, whose
+// component along the axis is 1, times the depth (the scene pass's geometry pass stores it).
+fn point_at_depth(pixel: vec2<f32>, depth: f32) -> vec3<f32> {
+    let k = frame.intrinsics;
+    let d = vec3<f32>((pixel.x - k.z) / k.x, -(pixel.y - k.w) / k.y, -1.0);
+    return frame.camera_position.xyz + (frame.world_from_camera * vec4<f32>(d, 0.0)).xyz * depth;
+}

@@ -51,6 +51,7 @@ pub mod gpu;
 pub mod gpu_scene;
 pub mod headless;
 pub mod light_space;
+pub mod light_tiles;
 pub mod lighting;
 pub mod lines_pass;
 pub mod markers_pass;

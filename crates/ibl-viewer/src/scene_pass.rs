@@ -1,19 +1,23 @@
 //! The scene pass (`scene_pass.wgsl`): virtual objects and local geometry lit by the lights with
-//! their shadows, composited into the background by differential rendering, 4x multisampled.
-//! See the shader's notes for the composite and `shadow_atlas.rs` for the shadows.
+//! their shadows, composited into the background by differential rendering, 4x multisampled and
+//! deferred: a geometry pass writes each sample's surface, then one full-screen pass shades each
+//! pixel's surfaces once. See the shader's notes for the composite and `shadow_atlas.rs` for
+//! the shadows.
 //!
 //! The scene's fixed choices (hard or soft shadows, composite rule, background kind, glossy
-//! source, ambient, background rays) are pipeline-overridable constants, one pipeline pair per
-//! [`ShaderVariant`], built the first time a frame needs it: a shader that branches on a uniform
-//! keeps every branch, which on lavapipe made the hard-shadow frame 4 to 5 times slower than the
-//! same shader with the soft branch compiled away (BENCHMARKS.md, "Viewer").
+//! source, ambient, background rays) are pipeline-overridable constants, one shading pipeline
+//! per [`ShaderVariant`], built the first time a frame needs it: a shader that branches on a
+//! uniform keeps every branch, which on lavapipe made the hard-shadow frame 4 to 5 times slower
+//! than the same shader with the soft branch compiled away (BENCHMARKS.md, "Viewer"). The
+//! geometry pass is the same for every variant.
 
 use std::collections::HashMap;
 
 use crate::environment_maps::EnvironmentMaps;
-use crate::frame_targets::{COVERAGE_FORMAT, FrameTargets, MSAA_SAMPLES};
+use crate::frame_targets::{COVERAGE_FORMAT, FrameTargets, GBUFFER_FORMATS, MSAA_SAMPLES};
 use crate::gpu::{DEPTH_FORMAT, GpuContext, HDR_FORMAT};
 use crate::gpu_scene::GpuScene;
+use crate::light_tiles::LightTiles;
 use crate::scene_geometry::{VERTEX_ATTRIBUTES, Vertex};
 use crate::shadow_atlas::ShadowAtlases;
 use crate::textures::HdrTexture;
@@ -35,10 +39,13 @@ pub struct ShaderVariant {
     pub background_rays: u32,
     /// The real geometry lies in one plane (`FrameUniform::real_plane`).
     pub flat_real_layer: bool,
+    /// Real surfaces loop over their screen tile's lights (`light_tiles.rs`; else over every
+    /// light, and the culling pass does not run).
+    pub tiled_lights: bool,
 }
 
 impl ShaderVariant {
-    fn constants(&self) -> [(&'static str, f64); 7] {
+    fn constants(&self) -> [(&'static str, f64); 8] {
         let flag = |b: bool| if b { 1.0 } else { 0.0 };
         [
             ("SOFT_SHADOWS", flag(self.soft_shadows)),
@@ -51,6 +58,7 @@ impl ShaderVariant {
                 f64::from(self.background_rays.clamp(1, 8)),
             ),
             ("FLAT_REAL_LAYER", flag(self.flat_real_layer)),
+            ("TILED_LIGHTS", flag(self.tiled_lights)),
         ]
     }
 }
@@ -64,22 +72,32 @@ fn vertex_buffer_layout() -> wgpu::VertexBufferLayout<'static> {
     }
 }
 
-/// The geometry and sky pipelines of one variant.
-#[derive(Debug)]
-struct VariantPipelines {
-    geometry: wgpu::RenderPipeline,
-    sky: wgpu::RenderPipeline,
-}
-
 /// Pipelines and samplers of the scene pass.
 #[derive(Debug)]
 pub struct ScenePass {
     module: wgpu::ShaderModule,
-    pipeline_layout: wgpu::PipelineLayout,
-    pipelines: HashMap<ShaderVariant, VariantPipelines>,
+    /// The geometry pass (group 0 only).
+    geometry: wgpu::RenderPipeline,
+    /// Groups 0 and 1 (the geometry pass's samples).
+    shading_layout: wgpu::PipelineLayout,
+    /// The shading pipeline of each variant built so far.
+    shading: HashMap<ShaderVariant, wgpu::RenderPipeline>,
     layout: wgpu::BindGroupLayout,
+    gbuffer_layout: wgpu::BindGroupLayout,
+    light_tiles: LightTiles,
     probe_sampler: wgpu::Sampler,
     shadow_sampler: wgpu::Sampler,
+}
+
+/// The bind groups a scene pass records with.
+#[derive(Debug)]
+pub struct SceneBindGroups {
+    /// [`ScenePass::bind_group`].
+    pub scene: wgpu::BindGroup,
+    /// The shading pass's group 1 ([`ScenePass::target_bind_groups`]).
+    pub shading_targets: wgpu::BindGroup,
+    /// The light culling's group ([`ScenePass::target_bind_groups`]).
+    pub light_tiles: wgpu::BindGroup,
 }
 
 /// The textures a scene pass reads besides the scene buffers.
@@ -159,16 +177,53 @@ impl ScenePass {
                 },
             ],
         });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("scene pass"),
+        let samples = |binding| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: fragment,
+            ty: wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                view_dimension: wgpu::TextureViewDimension::D2,
+                multisampled: true,
+            },
+            count: None,
+        };
+        let gbuffer_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("scene gbuffer"),
+            entries: &[
+                samples(0),
+                samples(1),
+                samples(2),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 3,
+                    visibility: fragment,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: storage,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+            ],
+        });
+        let geometry_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("scene geometry"),
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
+        let shading_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("scene shading"),
+            bind_group_layouts: &[Some(&layout), Some(&gbuffer_layout)],
+            immediate_size: 0,
+        });
+        let geometry = geometry_pipeline(device, &module, &geometry_layout);
         ScenePass {
             module,
-            pipeline_layout,
-            pipelines: HashMap::new(),
+            geometry,
+            shading_layout,
+            shading: HashMap::new(),
             layout,
+            gbuffer_layout,
+            light_tiles: LightTiles::new(gpu),
             probe_sampler: device.create_sampler(&crate::textures::probe_sampler_descriptor()),
             shadow_sampler: device.create_sampler(&wgpu::SamplerDescriptor {
                 label: Some("shadow comparison"),
@@ -180,13 +235,12 @@ impl ScenePass {
         }
     }
 
-    /// Builds the pipelines of `variant` unless they exist (the first frame of a scene, or after
-    /// a setting changed; lavapipe compiles the shader then).
+    /// Builds the shading pipeline of `variant` unless it exists (the first frame of a scene,
+    /// or after a setting changed; lavapipe compiles the shader then).
     pub fn prepare(&mut self, gpu: &GpuContext, variant: ShaderVariant) {
-        if self.pipelines.contains_key(&variant) {
+        if self.shading.contains_key(&variant) {
             return;
         }
-        let device = &gpu.device;
         let constants = variant.constants();
         let options = wgpu::PipelineCompilationOptions {
             constants: &constants,
@@ -196,71 +250,68 @@ impl ScenePass {
             Some(wgpu::ColorTargetState::from(HDR_FORMAT)),
             Some(wgpu::ColorTargetState::from(COVERAGE_FORMAT)),
         ];
-        let multisample = wgpu::MultisampleState {
-            count: MSAA_SAMPLES,
-            ..Default::default()
-        };
-        let vertex_layout = [Some(vertex_buffer_layout())];
-        let geometry = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("scene geometry"),
-            layout: Some(&self.pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &self.module,
-                entry_point: Some("vs_geometry"),
-                compilation_options: options.clone(),
-                buffers: &vertex_layout,
-            },
-            primitive: wgpu::PrimitiveState {
-                front_face: wgpu::FrontFace::Ccw,
-                cull_mode: None,
-                ..Default::default()
-            },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Greater),
-                stencil: wgpu::StencilState::default(),
-                bias: wgpu::DepthBiasState::default(),
-            }),
-            multisample,
-            fragment: Some(wgpu::FragmentState {
-                module: &self.module,
-                entry_point: Some("fs_geometry"),
-                compilation_options: options.clone(),
-                targets: &targets,
-            }),
-            multiview_mask: None,
-            cache: None,
+        let shading = gpu
+            .device
+            .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some("scene shading"),
+                layout: Some(&self.shading_layout),
+                vertex: wgpu::VertexState {
+                    module: &self.module,
+                    entry_point: Some("vs_fullscreen"),
+                    compilation_options: options.clone(),
+                    buffers: &[],
+                },
+                primitive: wgpu::PrimitiveState::default(),
+                depth_stencil: None,
+                multisample: wgpu::MultisampleState::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &self.module,
+                    entry_point: Some("fs_shade"),
+                    compilation_options: options,
+                    targets: &targets,
+                }),
+                multiview_mask: None,
+                cache: None,
+            });
+        self.shading.insert(variant, shading);
+    }
+
+    /// The bind groups of a frame size: the shading pass's view of `targets` (the geometry
+    /// pass's samples and the light masks) and the light culling's (rebuild when the targets
+    /// are).
+    pub fn target_bind_groups(
+        &self,
+        gpu: &GpuContext,
+        scene: &GpuScene,
+        targets: &FrameTargets,
+    ) -> (wgpu::BindGroup, wgpu::BindGroup) {
+        let view = wgpu::BindingResource::TextureView;
+        let shading = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("scene gbuffer"),
+            layout: &self.gbuffer_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: view(&targets.gbuffer[0]),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: view(&targets.gbuffer[1]),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: view(&targets.gbuffer[2]),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: targets.light_masks.as_entire_binding(),
+                },
+            ],
         });
-        let sky = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("scene sky"),
-            layout: Some(&self.pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &self.module,
-                entry_point: Some("vs_sky"),
-                compilation_options: options.clone(),
-                buffers: &[],
-            },
-            primitive: wgpu::PrimitiveState::default(),
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(false),
-                depth_compare: Some(wgpu::CompareFunction::GreaterEqual),
-                stencil: wgpu::StencilState::default(),
-                bias: wgpu::DepthBiasState::default(),
-            }),
-            multisample,
-            fragment: Some(wgpu::FragmentState {
-                module: &self.module,
-                entry_point: Some("fs_sky"),
-                compilation_options: options.clone(),
-                targets: &targets,
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
-        self.pipelines
-            .insert(variant, VariantPipelines { geometry, sky });
+        let culling =
+            self.light_tiles
+                .bind_group(gpu, scene, &targets.gbuffer, &targets.light_masks);
+        (shading, culling)
     }
 
     /// The bind group of a scene and its inputs (rebuild when a buffer or texture is replaced).
@@ -327,59 +378,134 @@ impl ScenePass {
         })
     }
 
-    /// Records the pass into `targets` (MSAA targets resolved into `radiance` and `coverage`)
-    /// with the pipelines of `variant` ([`ScenePass::prepare`]d; nothing is drawn otherwise).
+    /// Records the geometry pass into `targets`'s samples, the light culling, then the shading
+    /// pass into its `radiance` and `coverage`, with the shading pipeline of `variant`
+    /// ([`ScenePass::prepare`]d; nothing is drawn otherwise). `timestamps` are written at the
+    /// start of the first pass and the end of the last.
     pub fn record(
         &self,
         variant: ShaderVariant,
         encoder: &mut wgpu::CommandEncoder,
         targets: &FrameTargets,
         scene: &GpuScene,
-        bind_group: &wgpu::BindGroup,
-        timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
+        bind_groups: &SceneBindGroups,
+        timestamps: Option<(
+            wgpu::RenderPassTimestampWrites<'_>,
+            wgpu::RenderPassTimestampWrites<'_>,
+        )>,
     ) {
-        let clear = wgpu::Operations {
-            load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-            // The samples are resolved into the single-sample targets; they need not be kept.
-            store: wgpu::StoreOp::Discard,
-        };
-        let Some(pipelines) = self.pipelines.get(&variant) else {
+        let Some(shading) = self.shading.get(&variant) else {
             return;
         };
+        let (start, end) = timestamps.unzip();
+        let clear = wgpu::Operations {
+            load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+            store: wgpu::StoreOp::Store,
+        };
+        let gbuffer: Vec<Option<wgpu::RenderPassColorAttachment<'_>>> = targets
+            .gbuffer
+            .iter()
+            .map(|view| {
+                Some(wgpu::RenderPassColorAttachment {
+                    view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: clear,
+                })
+            })
+            .collect();
+        {
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("scene geometry"),
+                color_attachments: &gbuffer,
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &targets.msaa_depth,
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(0.0),
+                        store: wgpu::StoreOp::Discard,
+                    }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: start,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_bind_group(0, &bind_groups.scene, &[]);
+            pass.set_pipeline(&self.geometry);
+            draw_geometry(&mut pass, scene);
+        }
+        if variant.tiled_lights {
+            self.light_tiles
+                .record(encoder, &bind_groups.light_tiles, targets.size);
+        }
+        let output = |view| {
+            Some(wgpu::RenderPassColorAttachment {
+                view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: clear,
+            })
+        };
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("scene"),
+            label: Some("scene shading"),
             color_attachments: &[
-                Some(wgpu::RenderPassColorAttachment {
-                    view: &targets.msaa_radiance,
-                    depth_slice: None,
-                    resolve_target: Some(&targets.radiance_view),
-                    ops: clear,
-                }),
-                Some(wgpu::RenderPassColorAttachment {
-                    view: &targets.msaa_coverage,
-                    depth_slice: None,
-                    resolve_target: Some(&targets.coverage_view),
-                    ops: clear,
-                }),
+                output(&targets.radiance_view),
+                output(&targets.coverage_view),
             ],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &targets.msaa_depth,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(0.0),
-                    store: wgpu::StoreOp::Discard,
-                }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: timestamps,
+            depth_stencil_attachment: None,
+            timestamp_writes: end,
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_bind_group(0, bind_group, &[]);
-        pass.set_pipeline(&pipelines.geometry);
-        draw_geometry(&mut pass, scene);
-        pass.set_pipeline(&pipelines.sky);
+        pass.set_bind_group(0, &bind_groups.scene, &[]);
+        pass.set_bind_group(1, &bind_groups.shading_targets, &[]);
+        pass.set_pipeline(shading);
         pass.draw(0..3, 0..1);
     }
+}
+
+/// The geometry pass's pipeline (`fs_gbuffer`; the same for every variant).
+fn geometry_pipeline(
+    device: &wgpu::Device,
+    module: &wgpu::ShaderModule,
+    layout: &wgpu::PipelineLayout,
+) -> wgpu::RenderPipeline {
+    let targets = GBUFFER_FORMATS.map(|format| Some(wgpu::ColorTargetState::from(format)));
+    let vertex_layout = [Some(vertex_buffer_layout())];
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("scene geometry"),
+        layout: Some(layout),
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some("vs_geometry"),
+            compilation_options: Default::default(),
+            buffers: &vertex_layout,
+        },
+        primitive: wgpu::PrimitiveState {
+            front_face: wgpu::FrontFace::Ccw,
+            cull_mode: None,
+            ..Default::default()
+        },
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: DEPTH_FORMAT,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Greater),
+            stencil: wgpu::StencilState::default(),
+            bias: wgpu::DepthBiasState::default(),
+        }),
+        multisample: wgpu::MultisampleState {
+            count: MSAA_SAMPLES,
+            ..Default::default()
+        },
+        fragment: Some(wgpu::FragmentState {
+            module,
+            entry_point: Some("fs_gbuffer"),
+            compilation_options: Default::default(),
+            targets: &targets,
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
 }
 
 /// Draws the real geometry (instance 0) and each virtual object (instance k + 1).

@@ -1,9 +1,21 @@
 // The scene pass (scene_pass.rs); prepended by gpu_scene.wgsl and shadow_lookup.wgsl.
 //
-// Geometry first, then the sky: a full-screen triangle at the far plane that the depth test
-// keeps only where no geometry was drawn. Every fragment writes the final composite of
-// differential rendering (Debevec 1998; Grosch 2005 section 4.1), the same per-sample rule as
-// ibl-render's `render`:
+// Deferred, in two passes, so that every pixel is shaded once: lavapipe shades whole 4 x 4
+// blocks per triangle, and a mesh of triangles a few pixels wide (the bunny's are about 6)
+// paid for its shading several times over in a forward pass (BENCHMARKS.md, "Viewer").
+//
+// 1. The geometry pass (`vs_geometry`, `fs_gbuffer`), 4x multisampled with a depth test,
+//    writes per sample what shading needs: the view depth of the surface at the pixel centre,
+//    the surface's material and layer, and its shading and geometric normals (both already
+//    turned to face the viewer). A triangle's fragment is evaluated once per pixel, at the
+//    pixel centre, and stored in the samples it covers, as a forward pass would shade it.
+// 2. The shading pass (`vs_fullscreen`, `fs_shade`), one full-screen triangle: each pixel
+//    groups its samples into surfaces (samples of the same material and layer whose points
+//    and normals agree: one surface across the shared edge of two triangles of a smooth
+//    mesh), shades each surface once and the sky once, and writes the samples' mean.
+//
+// Every surface gets the final composite of differential rendering (Debevec 1998; Grosch 2005
+// section 4.1), the same per-sample rule as ibl-render's `render`:
 //
 // - virtual object: its own radiance, lit by the lights (each with its shadow from the real and
 //   the virtual atlas), the hybrid ambient, mirrors and optionally glossy lobes reflecting the
@@ -16,10 +28,11 @@
 //
 // B along a pixel is, as in ibl-render's `background`, the mean of an n x n grid of sub-pixel
 // rays each reading its nearest probe texel (panorama), or the photo's pixel (photo). On real
-// surfaces the rays run from the probe's centre to the surface (Grosch 2005 section 4.4: the
-// probe projected on the geometry), which equals the camera's rays when the camera is at the
-// probe's centre. Coverage (location 1) is 1 on virtual objects: resolved, it is the object's
-// alpha, the CPU renderer's `object_coverage`.
+// surfaces the rays run from the probe's centre to where the camera's sub-pixel rays meet the
+// surface's plane (Grosch 2005 section 4.4: the probe projected on the geometry), which equals
+// the camera's rays when the camera is at the probe's centre. Coverage (location 1) is the
+// fraction of the pixel's samples on virtual objects: the object's alpha, the CPU renderer's
+// `object_coverage`.
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<uniform> lights: array<Light, MAX_SHADOWED_LIGHTS>;
@@ -33,6 +46,17 @@
 @group(0) @binding(9) var real_atlas: texture_depth_2d;
 @group(0) @binding(10) var virtual_atlas: texture_depth_2d;
 @group(0) @binding(11) var shadow_sampler: sampler_comparison;
+// The geometry pass's samples (frame_targets.rs): view depth (0 where no geometry was drawn),
+// surface id (material + 1, negated on virtual objects; 0 where no geometry was drawn) and the
+// octahedral shading and geometric normals.
+@group(1) @binding(0) var gbuffer_depth: texture_multisampled_2d<f32>;
+@group(1) @binding(1) var gbuffer_id: texture_multisampled_2d<f32>;
+@group(1) @binding(2) var gbuffer_normals: texture_multisampled_2d<f32>;
+// Per 8 x 8 pixel tile, LIGHT_WORDS words of one bit per light: the lights that can change the
+// tile's real surfaces (light_tiles.wgsl).
+@group(1) @binding(3) var<storage, read> light_masks: array<u32>;
+const LIGHT_TILE: u32 = 8u;
+const LIGHT_WORDS: u32 = 8u;
 
 const PI: f32 = 3.14159265358979;
 
@@ -50,6 +74,8 @@ override GLOSSY_FROM_PROBE: bool = false;
 override HAS_AMBIENT: bool = false;
 // Background rays per pixel axis (1 to 8).
 override BACKGROUND_RAYS: u32 = 4u;
+// Real surfaces take only their screen tile's lights (light_tiles.wgsl; else every light).
+override TILED_LIGHTS: bool = false;
 
 struct GeometryOut {
     @builtin(position) clip: vec4<f32>,
@@ -65,6 +91,9 @@ struct FragmentOut {
     @location(0) radiance: vec4<f32>,
     @location(1) coverage: vec4<f32>,
 };
+
+// Samples per pixel of the geometry pass (frame_targets.rs's MSAA_SAMPLES).
+const SAMPLES: u32 = 4u;
 
 @vertex
 fn vs_geometry(vertex: Vertex, @builtin(instance_index) object: u32) -> GeometryOut {
@@ -137,19 +166,28 @@ fn background_sky(pixel: vec2<f32>) -> vec3<f32> {
     return sum / f32(n * n);
 }
 
-// B on a real surface point p, with its screen derivatives, seen from the probe's centre.
-fn background_surface(pixel: vec2<f32>, p: vec3<f32>, dx: vec3<f32>, dy: vec3<f32>) -> vec3<f32> {
+// B on a real surface point p with camera-facing geometric normal ng, seen from the probe's
+// centre: each sub-pixel camera ray meets the surface's plane, and the probe is read along the
+// direction from its centre to there.
+fn background_surface(pixel: vec2<f32>, p: vec3<f32>, ng: vec3<f32>) -> vec3<f32> {
     if PHOTO_BACKGROUND {
         return photo_pixel(pixel);
     }
     let n = BACKGROUND_RAYS;
-    // The fragment is shaded at the pixel centre; sub-pixel offsets from there.
-    let centre = pixel - floor(pixel);
+    let corner = floor(pixel);
+    let eye = frame.camera_position.xyz;
+    let height = dot(p - eye, ng);
     var sum = vec3<f32>(0.0);
     for (var sy = 0u; sy < n; sy = sy + 1u) {
         for (var sx = 0u; sx < n; sx = sx + 1u) {
-            let o = (vec2<f32>(f32(sx), f32(sy)) + 0.5) / f32(n) - centre;
-            let q = p + dx * o.x + dy * o.y;
+            let at = corner + (vec2<f32>(f32(sx), f32(sy)) + 0.5) / f32(n);
+            let d = camera_ray(at);
+            let cos_d = dot(d, ng);
+            // A ray (nearly) parallel to the plane keeps the pixel centre's point.
+            var q = p;
+            if cos_d < -1e-4 {
+                q = eye + d * (height / cos_d);
+            }
             sum = sum + probe_nearest(normalize(q - frame.probe_position.xyz));
         }
     }
@@ -230,26 +268,44 @@ struct LightSums {
 };
 
 // One loop over the lights for both layers, so that the shadow look-ups are compiled once
-// (on lavapipe the size of the shader costs as much as the work it does: BENCHMARKS.md).
-fn light_sums(m: Material, p: vec3<f32>, f: SurfaceFrame, wo: vec3<f32>, on_virtual: bool, pixel_noise: f32) -> LightSums {
+// (on lavapipe the size of the shader costs as much as the work it does: BENCHMARKS.md). A
+// virtual object takes every light; a real surface only those its screen tile's mask names
+// (light_tiles.wgsl), the same for every pixel of the tile, starting at word `mask_base`.
+fn light_sums(m: Material, p: vec3<f32>, f: SurfaceFrame, wo: vec3<f32>, on_virtual: bool, pixel_noise: f32, mask_base: u32) -> LightSums {
     var sums = LightSums(vec3<f32>(0.0), vec3<f32>(0.0), false);
     // Real surfaces take their glossy lobe from the lights (ibl-render's rule).
     let with_lobe = !on_virtual || !GLOSSY_FROM_PROBE;
     let count = frame.counts.x;
-    for (var i = 0u; i < count; i = i + 1u) {
-        let wi = lights[i].direction.xyz;
-        let fc = reflection(m, f.ns, f.ng, wo, wi, with_lobe);
-        if all(fc <= vec3<f32>(0.0)) {
-            continue;
+    let words = (count + 31u) / 32u;
+    for (var word = 0u; word < words; word = word + 1u) {
+        var bits = 0xffffffffu;
+        if TILED_LIGHTS && !on_virtual {
+            bits = light_masks[mask_base + word];
         }
-        let vv = virtual_visibility(i, p, f.ng, pixel_noise);
-        if on_virtual || vv < 1.0 {
-            let e = fc * lights[i].irradiance.rgb * real_visibility(i, p, f.ng, pixel_noise);
-            if on_virtual {
-                sums.direct = sums.direct + e * vv;
-            } else {
-                sums.affected = true;
-                sums.change = sums.change + e * (vv - 1.0);
+        let left = count - 32u * word;
+        if left < 32u {
+            bits = bits & ((1u << left) - 1u);
+        }
+        loop {
+            if bits == 0u {
+                break;
+            }
+            let i = 32u * word + firstTrailingBit(bits);
+            bits = bits & (bits - 1u);
+            let wi = lights[i].direction.xyz;
+            let fc = reflection(m, f.ns, f.ng, wo, wi, with_lobe);
+            if all(fc <= vec3<f32>(0.0)) {
+                continue;
+            }
+            let vv = virtual_visibility(i, p, f.ng, pixel_noise);
+            if on_virtual || vv < 1.0 {
+                let e = fc * lights[i].irradiance.rgb * real_visibility(i, p, f.ng, pixel_noise);
+                if on_virtual {
+                    sums.direct = sums.direct + e * vv;
+                } else {
+                    sums.affected = true;
+                    sums.change = sums.change + e * (vv - 1.0);
+                }
             }
         }
     }
@@ -310,47 +366,160 @@ fn composite_real(m: Material, p: vec3<f32>, f: SurfaceFrame, wo: vec3<f32>, b: 
     return max(out, vec3<f32>(0.0));
 }
 
+// Octahedral encoding of a unit vector (Meyer et al. 2010), in [-1, 1]^2.
+fn oct_encode(n: vec3<f32>) -> vec2<f32> {
+    let q = n.xy / (abs(n.x) + abs(n.y) + abs(n.z));
+    if n.z >= 0.0 {
+        return q;
+    }
+    return (1.0 - abs(q.yx)) * select(vec2<f32>(-1.0), vec2<f32>(1.0), q >= vec2<f32>(0.0));
+}
+
+fn oct_decode(e: vec2<f32>) -> vec3<f32> {
+    var n = vec3<f32>(e, 1.0 - abs(e.x) - abs(e.y));
+    if n.z < 0.0 {
+        n = vec3<f32>((1.0 - abs(n.yx)) * select(vec2<f32>(-1.0), vec2<f32>(1.0), n.xy >= vec2<f32>(0.0)), n.z);
+    }
+    return normalize(n);
+}
+
+struct GBufferOut {
+    @location(0) depth: vec4<f32>,
+    @location(1) id: vec4<f32>,
+    @location(2) normals: vec4<f32>,
+};
+
 @fragment
-fn fs_geometry(in: GeometryOut, @builtin(front_facing) front: bool) -> FragmentOut {
-    // Derivatives first, in uniform control flow.
+fn fs_gbuffer(in: GeometryOut, @builtin(front_facing) front: bool) -> GBufferOut {
     let dx = dpdx(in.world);
     let dy = dpdy(in.world);
-    let m = materials[in.material];
-    let wo = normalize(frame.camera_position.xyz - in.world);
+    let eye = frame.camera_position.xyz;
+    let wo = normalize(eye - in.world);
     let f = facing(in.normal, dx, dy, wo, front);
-    let pixel = in.clip.xy;
-    let pixel_noise = noise(floor(pixel));
-    let sums = light_sums(m, in.world, f, wo, in.layer == 1u, pixel_noise);
-    var out: FragmentOut;
-    if in.layer == 1u {
-        out.radiance = vec4<f32>(shade_virtual(m, f, wo, sums), 1.0);
-        out.coverage = vec4<f32>(1.0, 0.0, 0.0, 1.0);
-    } else {
-        let b = background_surface(pixel, in.world, dx, dy);
-        out.radiance = vec4<f32>(composite_real(m, in.world, f, wo, b, sums, pixel_noise), 1.0);
-        out.coverage = vec4<f32>(0.0, 0.0, 0.0, 1.0);
-    }
+    var out: GBufferOut;
+    // The distance in front of the camera (point_at_depth).
+    out.depth = vec4<f32>(dot(eye - in.world, frame.world_from_camera[2].xyz), 0.0, 0.0, 0.0);
+    let id = f32(in.material + 1u);
+    out.id = vec4<f32>(select(id, -id, in.layer == 1u), 0.0, 0.0, 0.0);
+    out.normals = vec4<f32>(oct_encode(f.ns), oct_encode(f.ng));
     return out;
 }
 
-struct SkyOut {
+// A sample of the geometry pass.
+struct Surface {
+    // World point at the pixel centre.
+    p: vec3<f32>,
+    // Material + 1, negated on virtual objects; 0 for the sky.
+    id: f32,
+    ns: vec3<f32>,
+    ng: vec3<f32>,
+};
+
+fn surface_at(texel: vec2<i32>, pixel: vec2<f32>, s: i32) -> Surface {
+    var out: Surface;
+    out.id = textureLoad(gbuffer_id, texel, s).x;
+    out.p = point_at_depth(pixel, textureLoad(gbuffer_depth, texel, s).x);
+    let e = textureLoad(gbuffer_normals, texel, s);
+    out.ns = oct_decode(e.xy);
+    out.ng = oct_decode(e.zw);
+    return out;
+}
+
+// Whether two samples lie on one surface: the same material and layer, normals within about
+// 8 degrees and points within two pixel footprints (two triangles of a smooth mesh sharing the
+// pixel; an object's silhouette over itself or the ground parts by depth).
+fn same_surface(a: Surface, b: Surface, footprint: f32) -> bool {
+    return a.id == b.id && dot(a.ns, b.ns) > 0.99 && distance(a.p, b.p) < footprint;
+}
+
+// The composite radiance of one surface seen through `pixel`.
+fn shade_surface(s: Surface, pixel: vec2<f32>, pixel_noise: f32, mask_base: u32) -> vec3<f32> {
+    let m = materials[u32(abs(s.id)) - 1u];
+    let on_virtual = s.id < 0.0;
+    let wo = normalize(frame.camera_position.xyz - s.p);
+    var f: SurfaceFrame;
+    f.ns = s.ns;
+    f.ng = s.ng;
+    let sums = light_sums(m, s.p, f, wo, on_virtual, pixel_noise, mask_base);
+    if on_virtual {
+        return shade_virtual(m, f, wo, sums);
+    }
+    let b = background_surface(pixel, s.p, f.ng);
+    return composite_real(m, s.p, f, wo, b, sums, pixel_noise);
+}
+
+struct FullscreenOut {
     @builtin(position) clip: vec4<f32>,
 };
 
 @vertex
-fn vs_sky(@builtin(vertex_index) index: u32) -> SkyOut {
+fn vs_fullscreen(@builtin(vertex_index) index: u32) -> FullscreenOut {
     let x = f32((index << 1u) & 2u) * 2.0 - 1.0;
     let y = f32(index & 2u) * 2.0 - 1.0;
-    var out: SkyOut;
-    // Depth 0: the far plane of the reversed depth range.
+    var out: FullscreenOut;
     out.clip = vec4<f32>(x, y, 0.0, 1.0);
     return out;
 }
 
 @fragment
-fn fs_sky(in: SkyOut) -> FragmentOut {
+fn fs_shade(in: FullscreenOut) -> FragmentOut {
+    let pixel = in.clip.xy;
+    let texel = vec2<i32>(floor(pixel));
+    let pixel_noise = noise(floor(pixel));
+    let tiles_x = (u32(frame.viewport.x) + LIGHT_TILE - 1u) / LIGHT_TILE;
+    let tile = vec2<u32>(texel) / LIGHT_TILE;
+    let mask_base = (tile.y * tiles_x + tile.x) * LIGHT_WORDS;
+    // Most pixels lie inside one triangle (or the sky): their samples hold the same fragment,
+    // so sample 0 stands for all of them and the rest are not decoded.
+    let id0 = textureLoad(gbuffer_id, texel, 0).x;
+    let depth0 = textureLoad(gbuffer_depth, texel, 0).x;
+    var one_fragment = true;
+    for (var s = 1u; s < SAMPLES; s = s + 1u) {
+        one_fragment = one_fragment && textureLoad(gbuffer_id, texel, s).x == id0
+            && textureLoad(gbuffer_depth, texel, s).x == depth0;
+    }
+    let read = select(SAMPLES, 1u, one_fragment);
+    let share = f32(SAMPLES / read);
+    // Group the samples into surfaces: `surfaces[g]` is the first sample of group g, `weights[g]`
+    // how many samples it stands for.
+    var surfaces: array<Surface, SAMPLES>;
+    var weights = array<f32, SAMPLES>(0.0, 0.0, 0.0, 0.0);
+    var groups = 0u;
+    var sky = 0.0;
+    var covered = 0.0;
+    for (var s = 0u; s < read; s = s + 1u) {
+        let a = surface_at(texel, pixel, i32(s));
+        if a.id == 0.0 {
+            sky = sky + share;
+            continue;
+        }
+        if a.id < 0.0 {
+            covered = covered + share;
+        }
+        // Two pixel footprints at this distance (intrinsics.y: focal length in pixels).
+        let footprint = 2.0 * distance(a.p, frame.camera_position.xyz) / frame.intrinsics.y;
+        var joined = false;
+        for (var g = 0u; g < groups; g = g + 1u) {
+            if !joined && same_surface(surfaces[g], a, footprint) {
+                weights[g] = weights[g] + share;
+                joined = true;
+            }
+        }
+        if !joined {
+            surfaces[groups] = a;
+            weights[groups] = share;
+            groups = groups + 1u;
+        }
+    }
+    var sum = vec3<f32>(0.0);
+    if sky > 0.0 {
+        sum = sky * background_sky(pixel);
+    }
+    for (var g = 0u; g < groups; g = g + 1u) {
+        sum = sum + weights[g] * shade_surface(surfaces[g], pixel, pixel_noise, mask_base);
+    }
     var out: FragmentOut;
-    out.radiance = vec4<f32>(background_sky(in.clip.xy), 1.0);
-    out.coverage = vec4<f32>(0.0, 0.0, 0.0, 1.0);
+    out.radiance = vec4<f32>(sum / f32(SAMPLES), 1.0);
+    out.coverage = vec4<f32>(covered / f32(SAMPLES), 0.0, 0.0, 1.0);
     return out;
 }

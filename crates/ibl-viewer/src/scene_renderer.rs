@@ -19,7 +19,7 @@ use crate::gpu::GpuContext;
 use crate::gpu_scene::{FrameUniform, GpuLight, GpuObject, GpuScene, mat3_columns, vec4};
 use crate::lighting::SceneLighting;
 use crate::scene_model::SceneModel;
-use crate::scene_pass::{ScenePass, ScenePassInputs, ShaderVariant};
+use crate::scene_pass::{SceneBindGroups, ScenePass, ScenePassInputs, ShaderVariant};
 use crate::shadow_atlas::ShadowAtlases;
 use crate::textures::{HdrTexture, black_texture, upload_hdr};
 use crate::timing::{PassTimer, PassTimes, SCENE_PASSES};
@@ -74,7 +74,7 @@ pub struct SceneRenderer {
     ambient: HdrTexture,
     photo: HdrTexture,
     targets: FrameTargets,
-    bind_group: wgpu::BindGroup,
+    bind_groups: SceneBindGroups,
     lighting: Option<SceneLighting>,
     gpu_lights: Vec<GpuLight>,
     /// Placements the virtual atlas was drawn with.
@@ -154,6 +154,8 @@ impl SceneRenderer {
                 shadows: &shadows,
             },
         );
+        let (shading_targets, light_tiles) =
+            scene_pass.target_bind_groups(gpu, &gpu_scene, &targets);
         gpu.take_errors()?;
         Ok(SceneRenderer {
             gpu_scene,
@@ -164,7 +166,11 @@ impl SceneRenderer {
             ambient,
             photo,
             targets,
-            bind_group,
+            bind_groups: SceneBindGroups {
+                scene: bind_group,
+                shading_targets,
+                light_tiles,
+            },
             lighting: None,
             gpu_lights: Vec::new(),
             drawn_placements: None,
@@ -177,7 +183,7 @@ impl SceneRenderer {
     }
 
     fn rebind(&mut self, gpu: &GpuContext) {
-        self.bind_group = self.scene_pass.bind_group(
+        self.bind_groups.scene = self.scene_pass.bind_group(
             gpu,
             &self.gpu_scene,
             &ScenePassInputs {
@@ -216,6 +222,11 @@ impl SceneRenderer {
             return Ok(());
         }
         self.targets = FrameTargets::new(gpu, width, height)?;
+        let (shading_targets, light_tiles) =
+            self.scene_pass
+                .target_bind_groups(gpu, &self.gpu_scene, &self.targets);
+        self.bind_groups.shading_targets = shading_targets;
+        self.bind_groups.light_tiles = light_tiles;
         self.photo = photo_texture(gpu, model, self.photo_source.as_ref(), width, height);
         self.rebind(gpu);
         Ok(())
@@ -301,8 +312,14 @@ impl SceneRenderer {
     }
 
     /// The pipeline constants of a frame of `model` drawn with `settings`.
-    fn shader_variant(&self, model: &SceneModel, settings: &SceneFrameSettings) -> ShaderVariant {
+    fn shader_variant(
+        &self,
+        model: &SceneModel,
+        settings: &SceneFrameSettings,
+        lights: u32,
+    ) -> ShaderVariant {
         ShaderVariant {
+            tiled_lights: lights >= crate::light_tiles::MIN_TILED_LIGHTS,
             soft_shadows: model.description.lighting.shadows == ibl_scene::ShadowKind::Soft,
             ratio_rule: model.description.render.composite == CompositeRule::Ratio,
             photo_background: matches!(model.scene.background, Background::Photo(_)),
@@ -369,7 +386,7 @@ impl SceneRenderer {
         self.gpu_scene.write_transforms(gpu, &objects);
         let uniform = self.frame_uniform(model, settings, count);
         self.gpu_scene.write_frame(gpu, &uniform);
-        let variant = self.shader_variant(model, settings);
+        let variant = self.shader_variant(model, settings, count);
         self.scene_pass.prepare(gpu, variant);
 
         let mut encoder = gpu
@@ -389,13 +406,13 @@ impl SceneRenderer {
                 .draw_virtual(gpu, &mut encoder, &self.gpu_scene, count, t);
         }
         {
-            let t = self.timer.as_mut().and_then(|t| t.writes(2));
+            let t = self.timer.as_mut().and_then(|t| t.split_writes(2));
             self.scene_pass.record(
                 variant,
                 &mut encoder,
                 &self.targets,
                 &self.gpu_scene,
-                &self.bind_group,
+                &self.bind_groups,
                 t,
             );
         }

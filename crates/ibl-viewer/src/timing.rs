@@ -112,6 +112,34 @@ impl PassTimer {
         })
     }
 
+    /// The timestamp writes of pass `index` when it is recorded as two render passes: the
+    /// first writes the start, the second the end (marks it as run in this frame).
+    pub fn split_writes(
+        &mut self,
+        index: usize,
+    ) -> Option<(
+        wgpu::RenderPassTimestampWrites<'_>,
+        wgpu::RenderPassTimestampWrites<'_>,
+    )> {
+        if self.in_flight || index >= self.names.len() {
+            return None;
+        }
+        self.ran[index] = true;
+        let query_set = &self.query_sets[index];
+        Some((
+            wgpu::RenderPassTimestampWrites {
+                query_set,
+                beginning_of_pass_write_index: Some(0),
+                end_of_pass_write_index: None,
+            },
+            wgpu::RenderPassTimestampWrites {
+                query_set,
+                beginning_of_pass_write_index: None,
+                end_of_pass_write_index: Some(1),
+            },
+        ))
+    }
+
     /// Records the copy of this frame's timestamps for reading (call after the last pass).
     pub fn resolve(&mut self, encoder: &mut wgpu::CommandEncoder) {
         if self.in_flight {
