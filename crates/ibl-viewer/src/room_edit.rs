@@ -100,7 +100,8 @@ impl PickTable {
 }
 
 /// A new goniometric light placed by a click (Grosch 2005 section 4.2): on the surface the
-/// probe sees along `towards`, moved off it along its normal.
+/// probe sees along `towards`, moved off it along its normal. Movable (a later click sets
+/// `towards` again: [`RoomEditSession::moving`]) and rotatable (`rotation_deg`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct PlacedLight {
     /// Its IES or EULUMDAT file.
@@ -111,6 +112,9 @@ pub struct PlacedLight {
     pub offset_m: f32,
     /// The table's peak, probe units per sr (`peak_intensity` of an edits file).
     pub peak_intensity: f32,
+    /// Yaw, pitch and roll of the light's frame, degrees (0: aimed straight down; an edits
+    /// file's `rotation_deg`).
+    pub rotation_deg: [f32; 3],
 }
 
 /// A request to the worker: the edits to show.
@@ -129,8 +133,8 @@ impl EditRequest {
 }
 
 /// The edits file's form of a placed light: its world position from the room's geometry (the
-/// surface hit along the click's ray from the probe, moved along the surface's normal), aimed
-/// straight down, white.
+/// surface hit along the click's ray from the probe, moved along the surface's normal), turned
+/// by its rotation, white.
 fn light_spec(room: &ibl_room::Room, light: &PlacedLight) -> Result<LightSpec, String> {
     let direction = (room.world_from_probe * light.towards).normalize_or_zero();
     let hit = room
@@ -145,7 +149,7 @@ fn light_spec(room: &ibl_room::Room, light: &PlacedLight) -> Result<LightSpec, S
     Ok(LightSpec {
         file: light.file.clone(),
         position: room.probe_position + direction * hit.distance_m + normal * light.offset_m,
-        rotation_deg: [0.0; 3],
+        rotation_deg: light.rotation_deg,
         colour: Rgb::ONE,
         scale: IntensityScale::PeakIntensity(light.peak_intensity),
     })
@@ -280,6 +284,8 @@ pub struct RoomEditSession {
     pub placing: bool,
     /// The lights placed.
     pub lights: Vec<PlacedLight>,
+    /// The placed light the next click moves (it then clears; placing and picking wait).
+    pub moving: Option<usize>,
     /// The file, offset and peak the next light is placed with.
     pub light_file: String,
     /// See `light_file`.
@@ -317,6 +323,7 @@ impl RoomEditSession {
             picked_towards: None,
             placing: false,
             lights: Vec::new(),
+            moving: None,
             light_file: default_light_file(room),
             light_offset_m: DEFAULT_LIGHT_OFFSET_M,
             light_peak: DEFAULT_LIGHT_PEAK,
@@ -371,18 +378,33 @@ impl RoomEditSession {
         }
     }
 
-    /// What a click along `direction` (probe frame) does: places a light when placing is on,
-    /// else picks the group there when picking is on.
+    /// What a click along `direction` (probe frame) does: moves the light chosen to move there,
+    /// else places a light when placing is on, else picks the group there when picking is on.
     pub fn click(&mut self, direction: Vec3) {
-        if self.placing {
+        if let Some(k) = self.moving.take() {
+            if let Some(light) = self.lights.get_mut(k) {
+                light.towards = direction;
+            }
+        } else if self.placing {
             self.lights.push(PlacedLight {
                 file: PathBuf::from(self.light_file.trim()),
                 towards: direction,
                 offset_m: self.light_offset_m,
                 peak_intensity: self.light_peak,
+                rotation_deg: [0.0; 3],
             });
         } else if self.picking {
             self.pick(direction);
+        }
+    }
+
+    /// Removes placed light `k` (a pending move of it, or of a later one, is dropped).
+    pub fn remove_light(&mut self, k: usize) {
+        if k < self.lights.len() {
+            self.lights.remove(k);
+            if self.moving.is_some_and(|m| m >= k) {
+                self.moving = None;
+            }
         }
     }
 

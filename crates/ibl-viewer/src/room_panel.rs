@@ -230,13 +230,12 @@ pub fn materials_section(
             .logarithmic(true)
             .text("peak, probe units / sr"),
     );
-    for (k, l) in session.lights.iter().enumerate() {
-        ui.label(format!("light {}: {}", k + 1, l.file.display()));
-    }
+    placed_lights(ui, session);
     let edited = !session.materials.is_empty() || !session.lights.is_empty();
     if edited && ui.button("undo all").clicked() {
         session.materials.clear();
         session.lights.clear();
+        session.moving = None;
     }
     match &session.last {
         Some(Ok((line, _))) if edited => {
@@ -246,5 +245,60 @@ pub fn materials_section(
             ui.colored_label(egui::Color32::from_rgb(255, 110, 100), e.as_str());
         }
         _ => {}
+    }
+}
+
+/// Each placed light: its file, a button that makes the next click move it, its offset, peak
+/// and turn (yaw, pitch, roll), and a button that removes it. Every change re-renders the edits
+/// on the worker (Grosch 2005 section 4.2: the lights are movable and rotatable).
+fn placed_lights(ui: &mut egui::Ui, session: &mut RoomEditSession) {
+    let mut remove = None;
+    for k in 0..session.lights.len() {
+        let n = k + 1;
+        ui.label(format!("light {n}: {}", session.lights[k].file.display()));
+        ui.horizontal(|ui| {
+            let moving = session.moving == Some(k);
+            let label = if moving {
+                format!("click a surface for light {n}")
+            } else {
+                format!("move light {n}")
+            };
+            if ui.selectable_label(moving, label).clicked() {
+                session.moving = if moving { None } else { Some(k) };
+            }
+            if ui.button(format!("remove light {n}")).clicked() {
+                remove = Some(k);
+            }
+        });
+        let light = &mut session.lights[k];
+        ui.horizontal(|ui| {
+            ui.label(format!("turn light {n}"))
+                .on_hover_text("yaw, pitch, roll in degrees (0 0 0: aimed straight down)");
+            for value in &mut light.rotation_deg {
+                ui.add(
+                    egui::DragValue::new(value)
+                        .range(-180.0..=180.0)
+                        .speed(1.0)
+                        .suffix("\u{b0}"),
+                );
+            }
+        });
+        ui.horizontal(|ui| {
+            ui.add(
+                egui::DragValue::new(&mut light.offset_m)
+                    .range(0.0..=1.5)
+                    .speed(0.01)
+                    .suffix(" m off"),
+            );
+            ui.add(
+                egui::DragValue::new(&mut light.peak_intensity)
+                    .range(1.0..=400.0)
+                    .speed(1.0)
+                    .suffix(" peak"),
+            );
+        });
+    }
+    if let Some(k) = remove {
+        session.remove_light(k);
     }
 }

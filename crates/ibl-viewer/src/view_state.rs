@@ -573,8 +573,8 @@ impl ProbeState {
                 let d = self.settings.direction_at(px.x, px.y, size.0, size.1);
                 (d, self.model.radiance_towards(d))
             });
-        // A click picks the material group under the cursor, or places a light there, while
-        // the room's edits ask for it.
+        // A click picks the material group under the cursor, places a light there or moves a
+        // placed one there, while the room's edits ask for it.
         if response.clicked_by(egui::PointerButton::Primary)
             && let (Some(edit), Some((d, _))) = (self.edit.as_mut(), self.cursor)
         {

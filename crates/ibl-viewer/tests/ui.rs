@@ -283,12 +283,26 @@ fn editing_the_floor(gpu: &ibl_viewer::GpuContext) -> Harness<'static, ViewerApp
 
 /// A click (press and release in place) at the middle of the view.
 fn click_the_middle(h: &mut Harness<'static, ViewerApp>) {
-    let middle = egui::pos2(305.0, 690.0);
-    h.hover_at(middle);
+    click_at(h, egui::pos2(305.0, 690.0));
+}
+
+/// A click (press and release in place) at `at`.
+fn click_at(h: &mut Harness<'static, ViewerApp>, at: egui::Pos2) {
+    h.hover_at(at);
     h.step();
-    h.drag_at(middle);
+    h.drag_at(at);
     h.step();
-    h.drop_at(middle);
+    h.drop_at(at);
+}
+
+/// The edits over the probe, to change them as the panel's drag values do.
+fn edit_mut<'a>(
+    h: &'a mut Harness<'static, ViewerApp>,
+) -> &'a mut ibl_viewer::room_edit::RoomEditSession {
+    match &mut h.state_mut().content {
+        Content::Probe(p) => p.edit.as_mut().expect("editing"),
+        _ => panic!("a probe is open"),
+    }
 }
 
 #[test]
@@ -380,4 +394,64 @@ fn a_click_places_a_light_and_its_pool_brightens_the_floor() {
     let (was, now) = (*p.original.get(i, j), *p.model.latlong.get(i, j));
     assert!(now.g > 2.0 * was.g, "the pool: {now:?} against {was:?}");
     h.get_by_label_contains("1 light added");
+
+    // "move light 1", then a click elsewhere on the floor: the pool follows the light.
+    let latlong = ibl_core::LatLong::new(p.original.width(), p.original.height());
+    let pixel = |d: glam::Vec3| latlong.dir_to_pixel(d.as_dvec3());
+    let first = d;
+    h.get_by_label("move light 1").click();
+    h.step();
+    click_at(&mut h, egui::pos2(305.0 - 150.0, 690.0));
+    step_until(&mut h, |app| {
+        probe(app)
+            .edit
+            .as_ref()
+            .is_some_and(|e| e.lights[0].towards != first && e.shows_current_edits())
+    });
+    let p = probe(h.state());
+    let e = p.edit.as_ref().expect("editing");
+    assert_eq!(e.lights.len(), 1, "moved, not added");
+    assert_eq!(e.moving, None, "the move ends with its click");
+    let (k, l) = pixel(e.lights[0].towards);
+    let (was_there, now_there) = (*p.original.get(k, l), *p.model.latlong.get(k, l));
+    assert!(
+        now_there.g > 2.0 * was_there.g,
+        "the moved pool: {now_there:?} against {was_there:?}"
+    );
+    let left = p.model.latlong.get(i, j).g;
+    assert!(
+        left < 0.5 * now.g,
+        "where the pool was: {left} against {}",
+        now.g
+    );
+
+    // Turning the light 90 degrees (pitch) aims it along the floor: its pool below dims.
+    assert!(h.query_by_label_contains("turn light 1").is_some());
+    edit_mut(&mut h).lights[0].rotation_deg = [0.0, 90.0, 0.0];
+    step_until(&mut h, |app| {
+        probe(app)
+            .edit
+            .as_ref()
+            .is_some_and(|e| e.lights[0].rotation_deg[1] == 90.0 && e.shows_current_edits())
+    });
+    let turned = probe(h.state()).model.latlong.get(k, l).g;
+    assert!(
+        turned < 0.5 * now_there.g,
+        "the turned light's pool: {turned} against {}",
+        now_there.g
+    );
+
+    eprintln!(
+        "the pool (green): {:.3} over {:.3} where placed, {left:.3} after the move; {:.3} over \
+         {:.3} where moved, {turned:.3} turned 90 degrees",
+        now.g, was.g, now_there.g, was_there.g
+    );
+    // "remove light 1" leaves no light.
+    h.get_by_label("remove light 1").click();
+    step_until(&mut h, |app| {
+        probe(app)
+            .edit
+            .as_ref()
+            .is_some_and(|e| e.lights.is_empty())
+    });
 }
