@@ -154,6 +154,22 @@ fn refuses(args: &[&str], needle: &str) {
 #[test]
 fn bad_input_is_refused_with_status_2() {
     let dir = tempfile::tempdir().unwrap();
+    // A scene with a goniometric light (docs/SCENES.md, `[[luminaire]]`): the viewer draws
+    // directional lights only, and says so.
+    let assets = repo().join("assets");
+    let text = std::fs::read_to_string(assets.join("scenes/bunny-sky.toml"))
+        .unwrap()
+        .replace("\"../", &format!("\"{}/", assets.display()));
+    let lamp = format!(
+        "{text}\n[[luminaire]]\nfile = \"{}\"\nposition = [0.3, 0.4, 0.0]\npeak_intensity = 20.0\n",
+        assets.join("photometry/ies/umbrella.ies").display()
+    );
+    let lamp_scene = dir.path().join("lamp.toml");
+    std::fs::write(&lamp_scene, lamp).unwrap();
+    refuses(
+        &["view", lamp_scene.to_str().unwrap(), "--headless"],
+        "luminaire",
+    );
     let missing = dir.path().join("missing.toml");
     refuses(
         &["view", missing.to_str().unwrap(), "--headless"],

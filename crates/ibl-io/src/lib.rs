@@ -30,6 +30,7 @@ pub mod ktx2;
 pub mod ldr;
 pub mod light_export;
 pub mod light_file;
+pub mod luminaire_file;
 pub mod mesh_file;
 pub mod pfm;
 pub mod photo;

@@ -13,6 +13,7 @@ use ibl_scene::description::{BackgroundKind, GeometryDescription, ShapeKind};
 use ibl_scene::{MeshAsset, Scene, SceneDescription};
 
 use crate::IoError;
+use crate::luminaire_file::read_luminaire;
 use crate::mesh_file::{MeshLimits, read_mesh};
 
 /// Largest scene file accepted, bytes.
@@ -146,8 +147,24 @@ pub fn read_scene(path: &Path) -> Result<LoadedScene, IoError> {
     if let Some(p) = &lights_path {
         inputs.push(p.clone());
     }
-    let scene = Scene::assemble(&description, probe, photo, local, objects)
+    let mut scene = Scene::assemble(&description, probe, photo, local, objects)
         .map_err(|e| invalid(path, e.to_string()))?;
+    // The luminaires (checked by `assemble`'s validation): each file read and its light placed.
+    for (i, l) in description.luminaire.iter().enumerate() {
+        let field = format!("luminaire[{i}]");
+        let scale = l.scale(&field).map_err(|e| invalid(path, e.to_string()))?;
+        let p = resolve(l.file.as_path());
+        let placed = read_luminaire(
+            &p,
+            l.position.into(),
+            l.rotation_deg,
+            Rgb::from_array(l.colour),
+            scale,
+        )
+        .map_err(|e| asset_error(path, &format!("{field}.file"), e))?;
+        inputs.push(p);
+        scene.luminaires.push(placed.light);
+    }
     Ok(LoadedScene {
         description,
         scene,

@@ -133,6 +133,7 @@ impl FrameCompositor {
                 camera,
                 render: RenderDescription::default(),
                 lighting: LightingDescription::default(),
+                luminaires: Vec::new(),
             },
             settings,
         })

@@ -236,6 +236,7 @@ impl SyntheticDay {
             camera,
             render: RenderDescription::default(),
             lighting: LightingDescription::default(),
+            luminaires: Vec::new(),
         }
     }
 

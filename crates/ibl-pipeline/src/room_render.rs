@@ -52,11 +52,11 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use glam::{Vec2, Vec3};
-use ibl_core::EulerDegrees;
 use ibl_core::tonemap::{Display, ToneCurve, auto_exposure_stops};
 use ibl_core::{Image, Rgb};
 use ibl_io::WriteOptions;
-use ibl_light::{GoniometricLight, intensity_per_candela_for};
+use ibl_io::luminaire_file::read_luminaire;
+use ibl_light::GoniometricLight;
 use ibl_room::room_radiance::RoomRadiance;
 use ibl_room::{
     DisplayMode, FillTexture, FillTextureSettings, Group, GroupKind, HoleFill,
@@ -64,7 +64,8 @@ use ibl_room::{
     Room, RoomVolume, VolumeSettings, add_lights, change_materials, important_patches,
     render_novel_view,
 };
-use ibl_scene::description::GeometryDescription;
+pub use ibl_scene::description::IntensityScale;
+use ibl_scene::description::{GeometryDescription, LuminaireDescription};
 use ibl_scene::{Camera, GeometryLayer};
 use serde::{Deserialize, Serialize};
 
@@ -86,7 +87,7 @@ struct EditsFile {
     #[serde(default)]
     material: Vec<MaterialEntry>,
     #[serde(default)]
-    light: Vec<LightEntry>,
+    light: Vec<LuminaireDescription>,
     #[serde(default)]
     object: Vec<GeometryDescription>,
     #[serde(default = "default_display")]
@@ -108,23 +109,6 @@ fn default_important() -> usize {
 pub const MAX_OBJECTS: usize = 64;
 /// Most important patches asked for.
 pub const MAX_IMPORTANT_PATCHES: usize = 1024;
-
-#[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct LightEntry {
-    file: PathBuf,
-    position: [f32; 3],
-    #[serde(default)]
-    rotation_deg: [f32; 3],
-    #[serde(default = "white")]
-    colour: [f32; 3],
-    nits_per_unit: Option<f32>,
-    peak_intensity: Option<f32>,
-}
-
-fn white() -> [f32; 3] {
-    [1.0; 3]
-}
 
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -184,18 +168,7 @@ pub struct ViewEdit {
 }
 
 /// Most new lights in one edits file.
-pub const MAX_LIGHTS: usize = 64;
-
-/// How a light's candela become the probe's radiance unit (CONVENTIONS section 6).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum IntensityScale {
-    /// Absolute: a probe value of 1 is this many cd/m^2, so the light delivers `I / k` probe
-    /// units of radiance times sr.
-    NitsPerUnit(f32),
-    /// Normalised: the table scaled so that its peak is this many probe units per sr (the
-    /// probe's scale unknown, the light set by eye).
-    PeakIntensity(f32),
-}
+pub const MAX_LIGHTS: usize = ibl_scene::description::MAX_LUMINAIRES;
 
 /// A new goniometric light as the edits file places it (its file not read yet).
 #[derive(Clone, Debug, PartialEq)]
@@ -349,7 +322,7 @@ impl RoomEdits {
             .light
             .iter()
             .enumerate()
-            .map(|(k, l)| check_light(l, folder).map_err(|m| bad(format!("light[{k}]: {m}"))))
+            .map(|(k, l)| check_light(l, &format!("light[{k}]"), folder).map_err(bad))
             .collect::<Result<Vec<_>>>()?;
         let view = match &file.view {
             None => None,
@@ -405,75 +378,43 @@ impl RoomEdits {
     }
 }
 
-fn check_light(l: &LightEntry, folder: &Path) -> std::result::Result<LightSpec, String> {
-    let finite = |a: &[f32; 3]| a.iter().all(|x| x.is_finite());
-    if !finite(&l.position) || !finite(&l.rotation_deg) {
-        return Err("position and rotation_deg must be finite".into());
-    }
-    let colour = Rgb::from_array(l.colour);
-    if !colour.is_valid_radiance() || colour.luminance() <= 0.0 {
-        return Err(format!(
-            "colour {:?} must be finite, not negative and not black",
-            l.colour
-        ));
-    }
-    let positive = |v: f32| v.is_finite() && v > 0.0;
-    let scale = match (l.nits_per_unit, l.peak_intensity) {
-        (Some(_), Some(_)) => {
-            return Err(
-                "give nits_per_unit (absolute) or peak_intensity (normalised), not both".into(),
-            );
-        }
-        (Some(k), None) if positive(k) => IntensityScale::NitsPerUnit(k),
-        (None, Some(p)) if positive(p) => IntensityScale::PeakIntensity(p),
-        (None, None) => IntensityScale::NitsPerUnit(1.0),
-        _ => return Err("nits_per_unit and peak_intensity must be positive and finite".into()),
-    };
+/// An edits file's `[[light]]` (a scene's `[[luminaire]]` entry), checked, its file resolved
+/// against `folder`; errors name `field`.
+fn check_light(
+    l: &LuminaireDescription,
+    field: &str,
+    folder: &Path,
+) -> std::result::Result<LightSpec, String> {
+    l.validate(field).map_err(|e| e.to_string())?;
+    let scale = l.scale(field).map_err(|e| e.to_string())?;
     Ok(LightSpec {
         file: folder.join(&l.file),
         position: Vec3::from(l.position),
         rotation_deg: l.rotation_deg,
-        colour,
+        colour: Rgb::from_array(l.colour),
         scale,
     })
 }
 
 /// Reads `spec`'s photometric file and makes the light.
 fn load_light(spec: &LightSpec) -> Result<LoadedLight> {
-    let file = ibl_io::photometry::read_photometry(&spec.file)?;
-    let table = file.table().clone();
-    let peak_cd = table.peak();
-    let nits_per_unit = match spec.scale {
-        IntensityScale::NitsPerUnit(k) => k,
-        IntensityScale::PeakIntensity(p) => peak_cd / p,
-    };
-    let intensity_per_candela = intensity_per_candela_for(spec.colour, nits_per_unit);
-    if peak_cd <= 0.0 || intensity_per_candela.max_channel() <= 0.0 {
-        return Err(PipelineError::parameter(format!(
-            "{}: the luminaire emits no light (peak {peak_cd} cd)",
-            spec.file.display()
-        )));
-    }
-    let [yaw_deg, pitch_deg, roll_deg] = spec.rotation_deg;
-    let light = GoniometricLight {
-        position: spec.position,
-        world_from_light: EulerDegrees {
-            yaw_deg,
-            pitch_deg,
-            roll_deg,
-        }
-        .world_from_probe(),
-        table,
-        intensity_per_candela,
-    };
+    let placed = read_luminaire(
+        &spec.file,
+        spec.position,
+        spec.rotation_deg,
+        spec.colour,
+        spec.scale,
+    )?;
+    let light = placed.light;
+    let peak_cd = light.table.peak();
     let row = LightRow {
         file: spec.file.display().to_string(),
-        name: file.name().to_string(),
+        name: placed.file.name().to_string(),
         position: spec.position.to_array(),
         flux_lm: light.table.flux(),
-        stated_lm: file.stated_flux().luminaire_lumens(),
+        stated_lm: placed.file.stated_flux().luminaire_lumens(),
         peak_cd,
-        peak_intensity: peak_cd / nits_per_unit,
+        peak_intensity: peak_cd / placed.nits_per_unit,
     };
     Ok(LoadedLight { light, row })
 }

@@ -29,7 +29,9 @@
 //!
 //! **Goniometric lights** (Grosch 2005 section 4.2, new light sources): in every mode the
 //! lighting may also hold point lights with measured intensity distributions
-//! ([`Lighting::luminaires`], `ibl_light::GoniometricLight`, positioned in the world frame). A
+//! ([`Lighting::luminaires`], `ibl_light::GoniometricLight`, positioned in the world frame: a
+//! scene file's `[[luminaire]]` entries, `Scene::luminaires`, and any added by
+//! [`Lighting::with_luminaires`]). A
 //! diffuse or glossy vertex adds `f cos(theta_i) I(-w_i) / d^2` for each (EQ5 times the BSDF),
 //! with one shadow ray to the light's position: a delta light, so it is exact and noise-free, and
 //! neither the camera nor a BSDF sample can meet it. In the reference every path vertex adds it
@@ -137,7 +139,8 @@ pub struct Lighting {
     /// What diffuse and glossy surfaces are lit by.
     pub illumination: Illumination,
     /// Goniometric point lights added to the scene (world frame, the probe's radiance unit per
-    /// sr), lighting diffuse and glossy surfaces in every mode; none by default.
+    /// sr), lighting diffuse and glossy surfaces in every mode: the scene's own
+    /// (`Scene::luminaires`) and any added.
     pub luminaires: Vec<GoniometricLight>,
 }
 
@@ -156,7 +159,7 @@ impl Lighting {
         Ok(Lighting {
             environment: Self::environment(scene)?,
             illumination: Illumination::Environment,
-            luminaires: Vec::new(),
+            luminaires: scene.luminaires.clone(),
         })
     }
 
@@ -169,7 +172,7 @@ impl Lighting {
         Ok(Lighting {
             environment: Self::environment(scene)?,
             illumination: Illumination::Lights(light_list(scene, set, shadows)),
-            luminaires: Vec::new(),
+            luminaires: scene.luminaires.clone(),
         })
     }
 
@@ -194,7 +197,7 @@ impl Lighting {
                 light_list(scene, set, shadows),
                 Ambient::new(&ambient.rotated(rotation), occlusion_rays),
             ),
-            luminaires: Vec::new(),
+            luminaires: scene.luminaires.clone(),
         })
     }
 

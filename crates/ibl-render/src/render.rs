@@ -307,9 +307,16 @@ fn pixel(
                     sums.real_with += with.radiance;
                     sums.real_without += without;
                 } else {
-                    sums.without += with.radiance;
+                    // The same path without the objects: bit for bit this one, less the new
+                    // lights' share (the goniometric lights, absent without the objects; the
+                    // lights and hybrid modes evaluated it in the walk).
+                    let without = with
+                        .without_objects
+                        .unwrap_or(with.radiance - with.new_light);
+                    sums.without += without;
+                    sums.difference += with.radiance - without;
                     sums.real_with += with.radiance;
-                    sums.real_without += with.radiance;
+                    sums.real_without += without;
                 }
             }
         }

@@ -21,7 +21,10 @@
 //!
 //! In every mode the lighting's goniometric point lights ([`Lighting::luminaires`]) are added at
 //! each vertex that takes direct light (every vertex of the reference, the one vertex of the
-//! other modes), each through a shadow ray that stops at the light.
+//! other modes), each through a shadow ray that stops at the light. They are new lights: the
+//! walk without the objects ([`Layers::RealOnly`]) has none of them, and a path's share of them
+//! is [`PathRecord::new_light`], so that on real surfaces the composite adds their light to the
+//! background.
 //!
 //! Ray origins leave a surface by its hit point's error bound (pbrt-v4 section 6.8.6): the point
 //! moves along the geometric normal by `d = |n| . err` (`err` the per-axis bound of
@@ -90,6 +93,10 @@ pub struct PathRecord {
     /// lights and hybrid modes, for a path through [`Layers::WithObjects`] that met no virtual
     /// surface): then no second walk is needed, even when [`PathRecord::touched_virtual`].
     pub without_objects: Option<Rgb>,
+    /// The share of `radiance` that came from the lighting's goniometric lights: new lights,
+    /// absent from the scene without the objects (a path that never touched the virtual layer
+    /// is, without the objects, `radiance - new_light`).
+    pub new_light: Rgb,
 }
 
 /// Whether a ray towards a distant light is blocked, and by which layer.
@@ -127,6 +134,15 @@ impl LayeredLight {
             with: Rgb::ZERO,
             without: (state.layers == Layers::WithObjects && !state.touched_virtual)
                 .then_some(Rgb::ZERO),
+        }
+    }
+
+    /// Adds the light of a new source (a goniometric light) to the layer with the objects when
+    /// the ray is open: the scene without the objects has no such light.
+    #[inline]
+    fn add_new(&mut self, occlusion: Occlusion, value: Rgb) {
+        if occlusion == Occlusion::Open {
+            self.with += value;
         }
     }
 
@@ -197,6 +213,7 @@ impl<'a> Tracer<'a> {
         let mut bsdf_pdf: Option<f32> = None;
         let mut vertex = 0u32;
         let mut without_objects = None;
+        let mut new_light = Rgb::ZERO;
         loop {
             let Some((surface, is_virtual)) = self.closest(&ray, &mut state) else {
                 radiance += throughput * self.escaped(ray.direction, bsdf_pdf);
@@ -229,6 +246,7 @@ impl<'a> Tracer<'a> {
                         };
                         let none = LayeredLight::none(&state);
                         let luminaires = self.luminaires(&vertex, &mut state, none);
+                        new_light += throughput * luminaires.with;
                         radiance += throughput
                             * (self.environment_sample(&surface, &bsdf, wo, stream, &mut state)
                                 + luminaires.with);
@@ -240,8 +258,9 @@ impl<'a> Tracer<'a> {
                             bsdf: &bsdf,
                             wo,
                         };
-                        let direct = self.lights(list, &vertex, stream, &mut state, none)
-                            + self.luminaires(&vertex, &mut state, none);
+                        let lamps = self.luminaires(&vertex, &mut state, none);
+                        new_light += throughput * lamps.with;
+                        let direct = self.lights(list, &vertex, stream, &mut state, none) + lamps;
                         without_objects = direct
                             .without
                             .map(|w| radiance + throughput * w.map(|v| v.max(0.0)));
@@ -255,8 +274,10 @@ impl<'a> Tracer<'a> {
                             bsdf: &bsdf,
                             wo,
                         };
+                        let lamps = self.luminaires(&vertex, &mut state, none);
+                        new_light += throughput * lamps.with;
                         let direct = self.lights(list, &vertex, stream, &mut state, none)
-                            + self.luminaires(&vertex, &mut state, none)
+                            + lamps
                             + self.ambient(ambient, &surface, stream, &mut state, none);
                         without_objects = direct
                             .without
@@ -290,6 +311,7 @@ impl<'a> Tracer<'a> {
             touched_virtual: state.touched_virtual,
             rays: state.rays,
             without_objects,
+            new_light,
         }
     }
 
@@ -357,14 +379,17 @@ impl<'a> Tracer<'a> {
 
     /// Every goniometric point light (Grosch 2005 EQ5 times the BSDF): `f cos(theta_i) I(-w_i) /
     /// d^2`, `w_i` the unit direction to the light and `d` its distance, with a shadow ray that
-    /// stops at the light (a light below the geometric surface sends none).
+    /// stops at the light (a light below the geometric surface sends none). They are new light
+    /// sources (Grosch 2005 section 4.2): the scene without the objects, whose light the
+    /// background already shows, has none of theirs, so on real surfaces the composite adds
+    /// their light.
     fn luminaires(
         &self,
         vertex: &Vertex,
         state: &mut PathState,
         mut sum: LayeredLight,
     ) -> LayeredLight {
-        if self.lighting.luminaires.is_empty() {
+        if self.lighting.luminaires.is_empty() || state.layers == Layers::RealOnly {
             return sum;
         }
         let origin = above(vertex.surface);
@@ -384,7 +409,7 @@ impl<'a> Tracer<'a> {
                 continue;
             }
             let occlusion = self.occlusion_within(origin, wi, distance, state);
-            sum.add(occlusion, f_cos * intensity / d2);
+            sum.add_new(occlusion, f_cos * intensity / d2);
         }
         sum
     }

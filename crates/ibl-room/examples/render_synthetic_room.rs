@@ -57,6 +57,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         },
         render: RenderDescription::default(),
         lighting: LightingDescription::default(),
+        luminaires: Vec::new(),
     };
     let lighting = Lighting::reference(&scene)?;
     let half = (spp / 2).max(1);

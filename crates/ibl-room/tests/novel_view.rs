@@ -141,6 +141,7 @@ fn render_halves(
         camera,
         render: RenderDescription::default(),
         lighting: LightingDescription::default(),
+        luminaires: Vec::new(),
     };
     let lighting = Lighting::reference(&scene).expect("lighting");
     [1u64, 2].map(|seed| {

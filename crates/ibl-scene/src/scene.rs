@@ -8,6 +8,7 @@
 
 use glam::{Mat3, Vec2, Vec3};
 use ibl_core::{EulerDegrees, Image, Rgb};
+use ibl_light::GoniometricLight;
 
 use crate::description::{
     BackgroundKind, DescriptionError, GeometryDescription, LightingDescription, RenderDescription,
@@ -303,6 +304,9 @@ pub struct Scene {
     pub render: RenderDescription,
     /// Lighting settings from the file.
     pub lighting: LightingDescription,
+    /// The file's `[[luminaire]]` entries as lights (world frame, the probe's radiance unit per
+    /// sr): `ibl-io`'s scene reader reads their files; [`Scene::assemble`] leaves this empty.
+    pub luminaires: Vec<GoniometricLight>,
 }
 
 fn rgb(v: [f32; 3]) -> Rgb {
@@ -391,6 +395,7 @@ impl Scene {
             camera,
             render: description.render.clone(),
             lighting: description.lighting.clone(),
+            luminaires: Vec::new(),
         })
     }
 }

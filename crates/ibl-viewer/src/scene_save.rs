@@ -81,6 +81,9 @@ pub fn rebased(description: &SceneDescription, from: &Path, to: &Path) -> SceneD
             fix(p);
         }
     }
+    for luminaire in &mut d.luminaire {
+        fix(&mut luminaire.file);
+    }
     if let Some(outdoor) = &mut d.outdoor {
         fix(&mut outdoor.mask);
         fix(&mut outdoor.frames.source);

@@ -107,6 +107,7 @@ pub fn render_with_objects(
         },
         render: RenderDescription::default(),
         lighting: LightingDescription::default(),
+        luminaires: Vec::new(),
     };
     let lighting = Lighting::reference(&scene)
         .expect("lighting")

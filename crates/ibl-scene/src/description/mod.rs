@@ -27,6 +27,7 @@ mod camera;
 mod field;
 mod geometry;
 mod lighting;
+mod luminaire;
 mod material;
 mod outdoor;
 mod probe;
@@ -43,6 +44,7 @@ use field::invalid;
 pub(crate) use geometry::Layer;
 pub use geometry::{GeometryDescription, Scale, ShapeKind};
 pub use lighting::{LightingDescription, ShadowKind};
+pub use luminaire::{IntensityScale, LuminaireDescription, MAX_LUMINAIRES, validate_luminaires};
 pub use material::{
     DEFAULT_ALBEDO, DEFAULT_EXPONENT, DEFAULT_MIRROR, DEFAULT_SPECULAR, MaterialDescription,
     MaterialKind,
@@ -90,6 +92,10 @@ pub struct SceneDescription {
     /// Lighting approximation for the `lights` and `hybrid` modes.
     #[serde(default)]
     pub lighting: LightingDescription,
+    /// Goniometric point lights added to the scene (IES or EULUMDAT files), lighting its
+    /// surfaces in every render mode. Default none.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub luminaire: Vec<LuminaireDescription>,
     /// Outdoor AR under changing light (sun and sky estimated per video frame): the site, the
     /// probe's time, the estimation's mask and the frames. Default none: an indoor or still
     /// scene. With it, `camera` is the video camera and `background` a representative frame.
@@ -199,6 +205,7 @@ impl SceneDescription {
         }
         self.render.validate()?;
         self.lighting.validate()?;
+        validate_luminaires("luminaire", &self.luminaire)?;
         if let Some(outdoor) = &self.outdoor {
             outdoor.validate()?;
         }
