@@ -147,6 +147,10 @@ fn reference_render_writes_exr_png_and_summary() {
     );
     let png = image(&f.path("ref.png"));
     assert_eq!((png.width(), png.height()), (48, 36));
+    // A PNG output is its own preview: written and listed once.
+    let o = f.render("scene.toml", "only.png", &["--json"]);
+    let v = summary(&o, "reference", (48, 36));
+    assert_eq!(v["outputs"].as_array().unwrap().len(), 1, "{v}");
 }
 
 #[test]

@@ -267,6 +267,8 @@ fn output_paths(output: &Path, layers: Layers) -> Vec<PathBuf> {
         }
         paths.push(output.with_file_name(format!("{stem}-alpha.png")));
     }
+    // A PNG output is its own preview: written and reported once.
+    paths.dedup();
     paths
 }
 
