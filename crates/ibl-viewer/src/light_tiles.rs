@@ -166,6 +166,12 @@ mod tests {
         let shading = include_str!("scene_pass.wgsl");
         assert!(shading.contains(&format!("const LIGHT_TILE: u32 = {TILE}u;")));
         assert!(shading.contains(&format!("const LIGHT_WORDS: u32 = {WORDS}u;")));
+        // Both shaders read every sample of the geometry pass.
+        let samples = format!(
+            "const SAMPLES: u32 = {}u;",
+            crate::frame_targets::MSAA_SAMPLES
+        );
+        assert!(source.contains(&samples) && shading.contains(&samples));
         assert_eq!(tile_counts((640, 480)), (80, 60));
         assert_eq!(tile_counts((641, 1)), (81, 1));
         assert_eq!(mask_bytes((8, 8)), u64::from(WORDS) * 4);
