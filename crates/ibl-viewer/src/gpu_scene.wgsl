@@ -77,3 +77,17 @@ fn point_at_depth(pixel: vec2<f32>, depth: f32) -> vec3<f32> {
     let d = vec3<f32>((pixel.x - k.z) / k.x, -(pixel.y - k.w) / k.y, -1.0);
     return frame.camera_position.xyz + (frame.world_from_camera * vec4<f32>(d, 0.0)).xyz * depth;
 }
+
+// Samples per pixel of the scene's geometry pass (frame_targets.rs's MSAA_SAMPLES).
+const GBUFFER_SAMPLES: u32 = 4u;
+
+// The light masks of light_tiles.wgsl: per LIGHT_TILE x LIGHT_TILE pixel tile, LIGHT_WORDS
+// words of one bit per light (light_tiles.rs's TILE and WORDS).
+const LIGHT_TILE: u32 = 8u;
+const LIGHT_WORDS: u32 = 8u;
+
+// The first mask word of screen tile `tile` in a frame `width` pixels wide.
+fn light_mask_base(tile: vec2<u32>, width: u32) -> u32 {
+    let tiles_x = (width + LIGHT_TILE - 1u) / LIGHT_TILE;
+    return (tile.y * tiles_x + tile.x) * LIGHT_WORDS;
+}

@@ -9,9 +9,9 @@
 use crate::gpu::GpuContext;
 use crate::gpu_scene::{GpuScene, MAX_SHADOWED_LIGHTS};
 
-/// Screen tile side, pixels (`light_tiles.wgsl`'s `TILE`).
+/// Screen tile side, pixels (`gpu_scene.wgsl`'s `LIGHT_TILE`).
 pub const TILE: u32 = 8;
-/// Mask words per tile: one bit per light (`light_tiles.wgsl`'s `WORDS`).
+/// Mask words per tile: one bit per light (`gpu_scene.wgsl`'s `LIGHT_WORDS`).
 pub const WORDS: u32 = (MAX_SHADOWED_LIGHTS as u32).div_ceil(32);
 /// Fewest lights for which the culling runs: it costs about 13 ms a 640 x 480 frame on
 /// lavapipe, and one light tested per pixel costs less (the courtyard's sun, BENCHMARKS.md).
@@ -159,19 +159,14 @@ mod tests {
 
     #[test]
     fn the_shader_constants_match() {
+        // gpu_scene.wgsl, prepended to both the culling and the scene pass, declares them once.
+        let shared = include_str!("gpu_scene.wgsl");
+        assert!(shared.contains(&format!("const LIGHT_TILE: u32 = {TILE}u;")));
+        assert!(shared.contains(&format!("const LIGHT_WORDS: u32 = {WORDS}u;")));
+        let samples = crate::frame_targets::MSAA_SAMPLES;
+        assert!(shared.contains(&format!("const GBUFFER_SAMPLES: u32 = {samples}u;")));
         let source = include_str!("light_tiles.wgsl");
-        assert!(source.contains(&format!("const TILE: u32 = {TILE}u;")));
-        assert!(source.contains(&format!("const WORDS: u32 = {WORDS}u;")));
         assert!(source.contains(&format!("@workgroup_size({GROUP}, {GROUP})")));
-        let shading = include_str!("scene_pass.wgsl");
-        assert!(shading.contains(&format!("const LIGHT_TILE: u32 = {TILE}u;")));
-        assert!(shading.contains(&format!("const LIGHT_WORDS: u32 = {WORDS}u;")));
-        // Both shaders read every sample of the geometry pass.
-        let samples = format!(
-            "const SAMPLES: u32 = {}u;",
-            crate::frame_targets::MSAA_SAMPLES
-        );
-        assert!(source.contains(&samples) && shading.contains(&samples));
         assert_eq!(tile_counts((640, 480)), (80, 60));
         assert_eq!(tile_counts((641, 1)), (81, 1));
         assert_eq!(mask_bytes((8, 8)), u64::from(WORDS) * 4);

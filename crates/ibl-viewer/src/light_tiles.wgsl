@@ -14,11 +14,6 @@
 @group(0) @binding(3) var gbuffer_id: texture_multisampled_2d<f32>;
 @group(0) @binding(4) var<storage, read_write> masks: array<u32>;
 
-// Screen tile side, pixels, and mask words per tile (light_tiles.rs's TILE and WORDS).
-const TILE: u32 = 8u;
-const WORDS: u32 = 8u;
-const SAMPLES: u32 = 4u;
-
 // Whether light i's virtual-object shadow can reach the sphere (b, s). The tile is fitted
 // around the objects' bounding sphere (radius half its depth range, light_space.rs's
 // `around_sphere`), so a caster lies within that radius of the tile's axis; a receiver sees
@@ -40,21 +35,21 @@ fn reaches(i: u32, b: vec3<f32>, s: f32) -> bool {
 @compute @workgroup_size(8, 8)
 fn cs_light_tiles(@builtin(global_invocation_id) id: vec3<u32>) {
     let size = textureDimensions(gbuffer_depth);
-    let tiles = (size + vec2<u32>(TILE - 1u)) / TILE;
+    let tiles = (size + vec2<u32>(LIGHT_TILE - 1u)) / LIGHT_TILE;
     if id.x >= tiles.x || id.y >= tiles.y {
         return;
     }
     var lo = vec3<f32>(3.0e38);
     var hi = vec3<f32>(-3.0e38);
     var real = false;
-    for (var y = 0u; y < TILE; y = y + 1u) {
-        for (var x = 0u; x < TILE; x = x + 1u) {
-            let texel = id.xy * TILE + vec2<u32>(x, y);
+    for (var y = 0u; y < LIGHT_TILE; y = y + 1u) {
+        for (var x = 0u; x < LIGHT_TILE; x = x + 1u) {
+            let texel = id.xy * LIGHT_TILE + vec2<u32>(x, y);
             if any(texel >= size) {
                 continue;
             }
             let pixel = vec2<f32>(texel) + 0.5;
-            for (var s = 0u; s < SAMPLES; s = s + 1u) {
+            for (var s = 0u; s < GBUFFER_SAMPLES; s = s + 1u) {
                 if textureLoad(gbuffer_id, texel, s).x > 0.0 {
                     let p = point_at_depth(pixel, textureLoad(gbuffer_depth, texel, s).x);
                     lo = min(lo, p);
@@ -67,8 +62,8 @@ fn cs_light_tiles(@builtin(global_invocation_id) id: vec3<u32>) {
     let centre = 0.5 * (lo + hi);
     let radius = 0.5 * length(hi - lo);
     let count = frame.counts.x;
-    let base = (id.y * tiles.x + id.x) * WORDS;
-    for (var w = 0u; w < WORDS; w = w + 1u) {
+    let base = light_mask_base(id.xy, size.x);
+    for (var w = 0u; w < LIGHT_WORDS; w = w + 1u) {
         var bits = 0u;
         for (var k = 0u; k < 32u; k = k + 1u) {
             let i = w * 32u + k;

@@ -52,11 +52,9 @@
 @group(1) @binding(0) var gbuffer_depth: texture_multisampled_2d<f32>;
 @group(1) @binding(1) var gbuffer_id: texture_multisampled_2d<f32>;
 @group(1) @binding(2) var gbuffer_normals: texture_multisampled_2d<f32>;
-// Per 8 x 8 pixel tile, LIGHT_WORDS words of one bit per light: the lights that can change the
-// tile's real surfaces (light_tiles.wgsl).
+// Per screen tile, the lights that can change the tile's real surfaces (light_tiles.wgsl; the
+// layout is gpu_scene.wgsl's `light_mask_base`).
 @group(1) @binding(3) var<storage, read> light_masks: array<u32>;
-const LIGHT_TILE: u32 = 8u;
-const LIGHT_WORDS: u32 = 8u;
 
 const PI: f32 = 3.14159265358979;
 
@@ -91,9 +89,6 @@ struct FragmentOut {
     @location(0) radiance: vec4<f32>,
     @location(1) coverage: vec4<f32>,
 };
-
-// Samples per pixel of the geometry pass (frame_targets.rs's MSAA_SAMPLES).
-const SAMPLES: u32 = 4u;
 
 @vertex
 fn vs_geometry(vertex: Vertex, @builtin(instance_index) object: u32) -> GeometryOut {
@@ -466,24 +461,22 @@ fn fs_shade(in: FullscreenOut) -> FragmentOut {
     let pixel = in.clip.xy;
     let texel = vec2<i32>(floor(pixel));
     let pixel_noise = noise(floor(pixel));
-    let tiles_x = (u32(frame.viewport.x) + LIGHT_TILE - 1u) / LIGHT_TILE;
-    let tile = vec2<u32>(texel) / LIGHT_TILE;
-    let mask_base = (tile.y * tiles_x + tile.x) * LIGHT_WORDS;
+    let mask_base = light_mask_base(vec2<u32>(texel) / LIGHT_TILE, u32(frame.viewport.x));
     // Most pixels lie inside one triangle (or the sky): their samples hold the same fragment,
     // so sample 0 stands for all of them and the rest are not decoded.
     let id0 = textureLoad(gbuffer_id, texel, 0).x;
     let depth0 = textureLoad(gbuffer_depth, texel, 0).x;
     var one_fragment = true;
-    for (var s = 1u; s < SAMPLES; s = s + 1u) {
+    for (var s = 1u; s < GBUFFER_SAMPLES; s = s + 1u) {
         one_fragment = one_fragment && textureLoad(gbuffer_id, texel, s).x == id0
             && textureLoad(gbuffer_depth, texel, s).x == depth0;
     }
-    let read = select(SAMPLES, 1u, one_fragment);
-    let share = f32(SAMPLES / read);
+    let read = select(GBUFFER_SAMPLES, 1u, one_fragment);
+    let share = f32(GBUFFER_SAMPLES / read);
     // Group the samples into surfaces: `surfaces[g]` is the first sample of group g, `weights[g]`
     // how many samples it stands for.
-    var surfaces: array<Surface, SAMPLES>;
-    var weights = array<f32, SAMPLES>(0.0, 0.0, 0.0, 0.0);
+    var surfaces: array<Surface, GBUFFER_SAMPLES>;
+    var weights = array<f32, GBUFFER_SAMPLES>(0.0, 0.0, 0.0, 0.0);
     var groups = 0u;
     var sky = 0.0;
     var covered = 0.0;
@@ -519,7 +512,7 @@ fn fs_shade(in: FullscreenOut) -> FragmentOut {
         sum = sum + weights[g] * shade_surface(surfaces[g], pixel, pixel_noise, mask_base);
     }
     var out: FragmentOut;
-    out.radiance = vec4<f32>(sum / f32(SAMPLES), 1.0);
-    out.coverage = vec4<f32>(covered / f32(SAMPLES), 0.0, 0.0, 1.0);
+    out.radiance = vec4<f32>(sum / f32(GBUFFER_SAMPLES), 1.0);
+    out.coverage = vec4<f32>(covered / f32(GBUFFER_SAMPLES), 0.0, 0.0, 1.0);
     return out;
 }
