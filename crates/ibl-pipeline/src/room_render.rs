@@ -64,8 +64,7 @@ use ibl_room::{
     Room, RoomVolume, VolumeSettings, add_lights, change_materials, important_patches,
     render_novel_view,
 };
-pub use ibl_scene::description::IntensityScale;
-use ibl_scene::description::{GeometryDescription, LuminaireDescription};
+use ibl_scene::description::{GeometryDescription, IntensityScale, LuminaireDescription};
 use ibl_scene::{Camera, GeometryLayer};
 use serde::{Deserialize, Serialize};
 

@@ -21,8 +21,9 @@ use glam::Vec3;
 use ibl_core::{Image, LatLong, Rgb};
 use ibl_pipeline::progress::Silent;
 use ibl_pipeline::room_estimate::{EstimatedRoom, SamplingOptions, estimate_room};
-use ibl_pipeline::room_render::{EditReport, IntensityScale, LightSpec, RoomEdits, render_edits};
+use ibl_pipeline::room_render::{EditReport, LightSpec, RoomEdits, render_edits};
 use ibl_room::depth_map::NO_PATCH;
+use ibl_scene::description::IntensityScale;
 
 use crate::ViewerError;
 use crate::worker::LatestWorker;

@@ -99,14 +99,21 @@ impl PassTimer {
         })
     }
 
-    /// The timestamp writes of pass `index` (marks it as run in this frame).
-    pub fn writes(&mut self, index: usize) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
+    /// The query set of pass `index`, marking it as run in this frame (`None` while the last
+    /// frame's timestamps are being read, or for an unknown pass).
+    fn mark_run(&mut self, index: usize) -> Option<&wgpu::QuerySet> {
         if self.in_flight || index >= self.names.len() {
             return None;
         }
         self.ran[index] = true;
+        Some(&self.query_sets[index])
+    }
+
+    /// The timestamp writes of pass `index` (marks it as run in this frame).
+    pub fn writes(&mut self, index: usize) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
+        let query_set = self.mark_run(index)?;
         Some(wgpu::RenderPassTimestampWrites {
-            query_set: &self.query_sets[index],
+            query_set,
             beginning_of_pass_write_index: Some(0),
             end_of_pass_write_index: Some(1),
         })
@@ -121,11 +128,7 @@ impl PassTimer {
         wgpu::RenderPassTimestampWrites<'_>,
         wgpu::RenderPassTimestampWrites<'_>,
     )> {
-        if self.in_flight || index >= self.names.len() {
-            return None;
-        }
-        self.ran[index] = true;
-        let query_set = &self.query_sets[index];
+        let query_set = self.mark_run(index)?;
         Some((
             wgpu::RenderPassTimestampWrites {
                 query_set,

@@ -325,14 +325,7 @@ fn a_click_picks_the_floor_and_its_new_reflectance_edits_the_panorama() {
     };
     // The floor's new reflectance, as edits.toml sets it (docs/ROOMS.md section 11).
     let after = ibl_core::Rgb::new(0.60, 0.12, 0.08);
-    match &mut h.state_mut().content {
-        Content::Probe(p) => p
-            .edit
-            .as_mut()
-            .expect("editing")
-            .set_reflectance(floor, after),
-        _ => panic!("a probe is open"),
-    }
+    edit_mut(&mut h).set_reflectance(floor, after);
     step_until(&mut h, |app| {
         probe(app)
             .edit
