@@ -8,6 +8,7 @@ use ibl_scene::Material;
 use wgpu::util::DeviceExt;
 
 use crate::gpu::GpuContext;
+use crate::point_lights::GpuPointLight;
 use crate::scene_geometry::SceneGeometry;
 
 /// `Frame` of `gpu_scene.wgsl`.
@@ -152,6 +153,9 @@ pub struct GpuScene {
     pub transforms: wgpu::Buffer,
     /// Lights (uniform), [`MAX_SHADOWED_LIGHTS`] entries.
     pub lights: wgpu::Buffer,
+    /// The goniometric point lights (`point_lights.rs`), a uniform array of
+    /// `MAX_POINT_LIGHTS`.
+    pub point_lights: wgpu::Buffer,
     /// The frame uniform.
     pub frame: wgpu::Buffer,
 }
@@ -226,6 +230,15 @@ impl GpuScene {
             materials: storage(gpu, "materials", bytemuck::cast_slice(&materials)),
             transforms: storage(gpu, "objects", bytemuck::cast_slice(&transforms)),
             lights: lights_buffer(gpu),
+            point_lights: gpu
+                .device
+                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("point lights"),
+                    contents: bytemuck::cast_slice(
+                        &[GpuPointLight::zeroed(); crate::point_lights::MAX_POINT_LIGHTS],
+                    ),
+                    usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                }),
             frame: gpu.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("frame"),
                 size: std::mem::size_of::<FrameUniform>() as u64,
@@ -259,6 +272,15 @@ impl GpuScene {
         }
     }
 
+    /// Writes the point lights (at most `MAX_POINT_LIGHTS`).
+    pub fn write_point_lights(&self, gpu: &GpuContext, lights: &[GpuPointLight]) {
+        let lights = &lights[..lights.len().min(crate::point_lights::MAX_POINT_LIGHTS)];
+        if !lights.is_empty() {
+            gpu.queue
+                .write_buffer(&self.point_lights, 0, bytemuck::cast_slice(lights));
+        }
+    }
+
     /// Writes the frame uniform.
     pub fn write_frame(&self, gpu: &GpuContext, frame: &FrameUniform) {
         gpu.queue
@@ -277,6 +299,7 @@ mod tests {
         assert_eq!(std::mem::size_of::<GpuLight>(), 2 * 64 + 6 * 16);
         assert_eq!(std::mem::size_of::<GpuObject>(), 2 * 64 + 16);
         assert_eq!(std::mem::size_of::<GpuMaterial>(), 32);
+        assert_eq!(std::mem::size_of::<GpuPointLight>(), 64 + 16 * 15);
         assert_eq!(std::mem::size_of::<crate::scene_geometry::Vertex>(), 28);
     }
 
@@ -286,5 +309,10 @@ mod tests {
         assert!(include_str!("gpu_scene.wgsl").contains(&declared));
         // 64 KiB: the uniform binding size every wgpu backend allows (WebGPU's default limit).
         assert!(std::mem::size_of::<GpuLight>() * MAX_SHADOWED_LIGHTS <= 1 << 16);
+        let points = crate::point_lights::MAX_POINT_LIGHTS;
+        let declared = format!("const MAX_POINT_LIGHTS: u32 = {points}u;");
+        assert!(include_str!("gpu_scene.wgsl").contains(&declared));
+        assert!(std::mem::size_of::<GpuPointLight>() * points <= 1 << 16);
+        assert_eq!(points, ibl_scene::description::MAX_LUMINAIRES);
     }
 }

@@ -47,6 +47,62 @@ struct Light {
     virtual_extent: vec4<f32>,
 };
 
+// Goniometric point lights a frame draws (point_lights.rs's MAX_POINT_LIGHTS; a scene's
+// [[luminaire]] entries, ibl_scene's MAX_LUMINAIRES).
+const MAX_POINT_LIGHTS: u32 = 64u;
+
+// A goniometric point light (Grosch 2005 section 4.2) and its omnidirectional shadow: six cube
+// faces per atlas, each a 90-degree perspective view from the light along +-x, +-y, +-z
+// (`face_coords`), drawn into its own atlas tile, and only where casters can be seen.
+struct PointLight {
+    // xyz: the light's world position; w: the faces' near plane distance (world units).
+    position: vec4<f32>,
+    // x: the faces' far plane distance; y: the face tile's side in texels; z, w: 0.
+    shadow: vec4<f32>,
+    // Columns: rotation from world to the light's photometric frame (ibl-light's
+    // `light_from_world`).
+    light_from_world: mat4x4<f32>,
+    // Its intensity map's rows in the strip of maps (texture v0, dv); the strip's scale to
+    // intensity (probe units per sr); 0.
+    map: vec4<f32>,
+    // The six faces' tiles in each atlas (u0, v0, du, dv); du = 0 where the face sees no caster.
+    real_faces: array<vec4<f32>, 6>,
+    virtual_faces: array<vec4<f32>, 6>,
+};
+
+// Cube face `face` (0 +x, 1 -x, 2 +y, 3 -y, 4 +z, 5 -z) of vector v from a point light:
+// (x, y, z) with z the distance along the face's axis, x and y across it (both written and
+// read by this function only, so any fixed choice of axes works).
+fn face_coords(v: vec3<f32>, face: u32) -> vec3<f32> {
+    let axis = face / 2u;
+    let s = select(1.0, -1.0, (face & 1u) == 1u);
+    if axis == 0u {
+        return vec3<f32>(v.y, v.z, s * v.x);
+    }
+    if axis == 1u {
+        return vec3<f32>(v.z, v.x, s * v.y);
+    }
+    return vec3<f32>(v.x, v.y, s * v.z);
+}
+
+// The cube face a vector from a point light falls in: its largest component.
+fn face_of(v: vec3<f32>) -> u32 {
+    let a = abs(v);
+    if a.x >= a.y && a.x >= a.z {
+        return select(0u, 1u, v.x < 0.0);
+    }
+    if a.y >= a.z {
+        return select(2u, 3u, v.y < 0.0);
+    }
+    return select(4u, 5u, v.z < 0.0);
+}
+
+// The depth a face stores for a point at distance z along its axis: the perspective projection's
+// far (z - near) / ((far - near) z), 0 at the near plane and 1 at the far one.
+fn face_depth(z: f32, near: f32, far: f32) -> f32 {
+    return far * (z - near) / ((far - near) * z);
+}
+
 struct Object {
     // World from the frame the vertices were loaded in (identity for real geometry).
     world_from_load: mat4x4<f32>,

@@ -57,6 +57,7 @@ pub mod lines_pass;
 pub mod markers_pass;
 pub mod overlay_pipeline;
 pub mod panels;
+pub mod point_lights;
 pub mod probe_model;
 pub mod probe_pass;
 pub mod probe_renderer;

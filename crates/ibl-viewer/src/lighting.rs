@@ -35,6 +35,9 @@ pub const IRRADIANCE_MAP_WIDTH: usize = 128;
 pub struct SceneLighting {
     /// The directional lights (the CPU renderer's own list).
     pub lights: Vec<DirectionalLight>,
+    /// The goniometric point lights (a scene's `[[luminaire]]` entries: the CPU renderer's
+    /// `Lighting::luminaires`, `point_lights.rs`).
+    pub luminaires: Vec<ibl_light::GoniometricLight>,
     /// Hybrid mode: the ambient's irradiance `E(n)` on a world-frame lat-long grid.
     pub ambient: Option<Image<Rgb>>,
     /// A short description: `16 median-cut lights`, `8 lightgen lights + SH9 ambient`.
@@ -82,8 +85,14 @@ pub fn scene_lighting(request: &SceneLightingRequest) -> Result<SceneLighting, S
     if let Some(sh) = &ambient {
         summary += &format!(" + SH{} ambient", sh.bands() * sh.bands());
     }
+    match lighting.luminaires.len() {
+        0 => {}
+        1 => summary += " + 1 luminaire",
+        n => summary += &format!(" + {n} luminaires"),
+    }
     Ok(SceneLighting {
         lights: list.lights.clone(),
+        luminaires: lighting.luminaires.clone(),
         ambient: ambient
             .as_ref()
             .map(|sh| irradiance_map(sh, IRRADIANCE_MAP_WIDTH)),

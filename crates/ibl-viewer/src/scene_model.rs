@@ -71,13 +71,6 @@ impl SceneModel {
     /// Reads a scene file and everything it names (`ibl_io::read_scene`).
     pub fn open(path: &Path) -> Result<SceneModel, ViewerError> {
         let loaded = ibl_io::read_scene(path)?;
-        if !loaded.description.luminaire.is_empty() {
-            return Err(ViewerError::Parameter(format!(
-                "{}: the viewer does not draw [[luminaire]] lights yet (only directional lights \
-                 with shadow maps); `ibl render` renders them",
-                path.display()
-            )));
-        }
         let text = std::fs::read_to_string(path).map_err(|source| ibl_io::IoError::Io {
             path: path.to_path_buf(),
             source,

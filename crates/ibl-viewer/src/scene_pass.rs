@@ -42,10 +42,12 @@ pub struct ShaderVariant {
     /// Real surfaces loop over their screen tile's lights (`light_tiles.rs`; else over every
     /// light, and the culling pass does not run).
     pub tiled_lights: bool,
+    /// The scene has goniometric point lights (`point_lights.rs`).
+    pub point_lights: bool,
 }
 
 impl ShaderVariant {
-    fn constants(&self) -> [(&'static str, f64); 8] {
+    fn constants(&self) -> [(&'static str, f64); 9] {
         let flag = |b: bool| if b { 1.0 } else { 0.0 };
         [
             ("SOFT_SHADOWS", flag(self.soft_shadows)),
@@ -59,6 +61,7 @@ impl ShaderVariant {
             ),
             ("FLAT_REAL_LAYER", flag(self.flat_real_layer)),
             ("TILED_LIGHTS", flag(self.tiled_lights)),
+            ("POINT_LIGHTS", flag(self.point_lights)),
         ]
     }
 }
@@ -110,6 +113,8 @@ pub struct ScenePassInputs<'a> {
     pub photo: &'a HdrTexture,
     /// The shadow atlases.
     pub shadows: &'a ShadowAtlases,
+    /// The point lights' intensity maps (`point_lights::intensity_strip`).
+    pub intensity: &'a HdrTexture,
 }
 
 impl ScenePass {
@@ -117,9 +122,10 @@ impl ScenePass {
     pub fn new(gpu: &GpuContext) -> ScenePass {
         let device = &gpu.device;
         let source = format!(
-            "{}\n{}\n{}",
+            "{}\n{}\n{}\n{}",
             include_str!("gpu_scene.wgsl"),
             include_str!("shadow_lookup.wgsl"),
+            include_str!("point_lights.wgsl"),
             include_str!("scene_pass.wgsl")
         );
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
@@ -175,6 +181,8 @@ impl ScenePass {
                     ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
                     count: None,
                 },
+                buffer(12, wgpu::BufferBindingType::Uniform),
+                texture(13, filterable),
             ],
         });
         let samples = |binding| wgpu::BindGroupLayoutEntry {
@@ -373,6 +381,14 @@ impl ScenePass {
                 wgpu::BindGroupEntry {
                     binding: 11,
                     resource: wgpu::BindingResource::Sampler(&self.shadow_sampler),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 12,
+                    resource: scene.point_lights.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 13,
+                    resource: view(&inputs.intensity.view),
                 },
             ],
         })

@@ -23,7 +23,8 @@
 // - real surface: the background B at that point plus the change the objects make,
 //   `B + (with - without)` (difference) or `B with / without` (ratio, falling back to the
 //   difference where `without` is 0), where with and without light the real surface's albedo
-//   with and without the virtual casters;
+//   with and without the virtual casters, and only `with` has the goniometric point lights
+//   (new lights: their pool, and the shadows in it, join the background);
 // - sky: the background B.
 //
 // B along a pixel is, as in ibl-render's `background`, the mean of an n x n grid of sub-pixel
@@ -46,6 +47,9 @@
 @group(0) @binding(9) var real_atlas: texture_depth_2d;
 @group(0) @binding(10) var virtual_atlas: texture_depth_2d;
 @group(0) @binding(11) var shadow_sampler: sampler_comparison;
+// Goniometric point lights and the strip of their intensity maps (point_lights.wgsl).
+@group(0) @binding(12) var<uniform> point_lights: array<PointLight, MAX_POINT_LIGHTS>;
+@group(0) @binding(13) var intensity_maps: texture_2d<f32>;
 // The geometry pass's samples (frame_targets.rs): view depth (0 where no geometry was drawn),
 // surface id (material + 1, negated on virtual objects; 0 where no geometry was drawn) and the
 // octahedral shading and geometric normals.
@@ -435,7 +439,10 @@ fn shade_surface(s: Surface, pixel: vec2<f32>, pixel_noise: f32, mask_base: u32)
     var f: SurfaceFrame;
     f.ns = s.ns;
     f.ng = s.ng;
-    let sums = light_sums(m, s.p, f, wo, on_virtual, pixel_noise, mask_base);
+    var sums = light_sums(m, s.p, f, wo, on_virtual, pixel_noise, mask_base);
+    if POINT_LIGHTS {
+        sums = add_point_lights(m, s.p, f, wo, on_virtual, sums);
+    }
     if on_virtual {
         return shade_virtual(m, f, wo, sums);
     }

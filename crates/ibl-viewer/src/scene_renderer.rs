@@ -73,6 +73,8 @@ pub struct SceneRenderer {
     shadows: ShadowAtlases,
     ambient: HdrTexture,
     photo: HdrTexture,
+    /// The point lights' intensity maps (`point_lights::intensity_strip`).
+    intensity: HdrTexture,
     targets: FrameTargets,
     bind_groups: SceneBindGroups,
     lighting: Option<SceneLighting>,
@@ -144,6 +146,7 @@ impl SceneRenderer {
         let shadows = ShadowAtlases::new(gpu, 1, shadow_tile);
         let ambient = black_texture(&gpu.device, &gpu.queue, "no ambient");
         let photo = photo_texture(gpu, model, None, width, height);
+        let intensity = black_texture(&gpu.device, &gpu.queue, "no point lights");
         let bind_group = scene_pass.bind_group(
             gpu,
             &gpu_scene,
@@ -152,6 +155,7 @@ impl SceneRenderer {
                 ambient: &ambient,
                 photo: &photo,
                 shadows: &shadows,
+                intensity: &intensity,
             },
         );
         let (shading_targets, light_tiles) =
@@ -165,6 +169,7 @@ impl SceneRenderer {
             shadows,
             ambient,
             photo,
+            intensity,
             targets,
             bind_groups: SceneBindGroups {
                 scene: bind_group,
@@ -191,6 +196,7 @@ impl SceneRenderer {
                 ambient: &self.ambient,
                 photo: &self.photo,
                 shadows: &self.shadows,
+                intensity: &self.intensity,
             },
         );
     }
@@ -262,6 +268,18 @@ impl SceneRenderer {
             ),
             None => black_texture(&gpu.device, &gpu.queue, "no ambient"),
         };
+        self.intensity = if lighting.luminaires.is_empty() {
+            black_texture(&gpu.device, &gpu.queue, "no point lights")
+        } else {
+            upload_hdr(
+                &gpu.device,
+                &gpu.queue,
+                &crate::point_lights::intensity_strip(&lighting.luminaires),
+                "point light intensities",
+                1,
+                wgpu::TextureUsages::empty(),
+            )
+        };
         self.lighting = Some(lighting);
         self.lights_changed = true;
         self.rebind(gpu);
@@ -277,6 +295,7 @@ impl SceneRenderer {
         model: &SceneModel,
         settings: &SceneFrameSettings,
         lights: u32,
+        points: u32,
     ) -> FrameUniform {
         let c = &settings.camera;
         let (w, h) = self.targets.size;
@@ -297,7 +316,7 @@ impl SceneRenderer {
             probe_from_world: mat3_columns(probe.world_from_probe.transpose()),
             probe_position: vec4(probe.position, self.environment.scale),
             viewport: [w as f32, h as f32, 1.0 / w as f32, 1.0 / h as f32],
-            counts: [lights, 0, 0, 0],
+            counts: [lights, points, 0, 0],
             environment: [
                 self.environment.first_exponent,
                 self.environment.levels as f32,
@@ -317,6 +336,7 @@ impl SceneRenderer {
         model: &SceneModel,
         settings: &SceneFrameSettings,
         lights: u32,
+        points: u32,
     ) -> ShaderVariant {
         ShaderVariant {
             tiled_lights: lights >= crate::light_tiles::MIN_TILED_LIGHTS,
@@ -327,6 +347,7 @@ impl SceneRenderer {
             has_ambient: self.lighting.as_ref().is_some_and(|l| l.ambient.is_some()),
             background_rays: settings.background_rays.clamp(1, 8),
             flat_real_layer: self.real_plane.is_some(),
+            point_lights: points > 0,
         }
     }
 
@@ -339,14 +360,20 @@ impl SceneRenderer {
     ) -> FrameReport {
         let started = std::time::Instant::now();
         let count = self.lighting.as_ref().map_or(0, |l| l.lights.len()) as u32;
+        let luminaires = self
+            .lighting
+            .as_ref()
+            .map_or(&[][..], |l| &l.luminaires[..]);
+        let points = luminaires.len().min(crate::point_lights::MAX_POINT_LIGHTS) as u32;
         // Atlases sized for the lights and the requested tile.
+        let tiles = ShadowAtlases::tiles_for(count as usize, points as usize);
         let wanted = crate::light_space::AtlasLayout::new(
-            count.max(1),
+            tiles,
             settings.shadow_tile,
             gpu.max_texture_side(),
         );
         if wanted != self.shadows.real.layout {
-            self.shadows = ShadowAtlases::new(gpu, count.max(1), settings.shadow_tile);
+            self.shadows = ShadowAtlases::new(gpu, tiles, settings.shadow_tile);
             self.lights_changed = true;
             self.rebind(gpu);
         }
@@ -366,14 +393,22 @@ impl SceneRenderer {
         let mut draw_real = self.lights_changed;
         if moved || self.lights_changed {
             let lights = self.lighting.as_ref().map_or(&[][..], |l| &l.lights[..]);
+            let luminaires = self
+                .lighting
+                .as_ref()
+                .map_or(&[][..], |l| &l.luminaires[..]);
             let (gpu_lights, region_moved) = self.shadows.fit(
                 lights,
+                luminaires,
+                self.intensity.scale,
                 model.description.lighting.shadows,
                 sphere,
                 model.geometry.real_bounds(),
             );
             draw_real |= region_moved;
             self.gpu_scene.write_lights(gpu, &gpu_lights);
+            self.gpu_scene
+                .write_point_lights(gpu, self.shadows.point_lights());
             self.gpu_lights = gpu_lights;
         }
         let mut objects = vec![GpuObject::new(Affine3A::IDENTITY, false, false)];
@@ -384,9 +419,9 @@ impl SceneRenderer {
                 .map(|(i, &m)| GpuObject::new(m, true, settings.selected == Some(i))),
         );
         self.gpu_scene.write_transforms(gpu, &objects);
-        let uniform = self.frame_uniform(model, settings, count);
+        let uniform = self.frame_uniform(model, settings, count, points);
         self.gpu_scene.write_frame(gpu, &uniform);
-        let variant = self.shader_variant(model, settings, count);
+        let variant = self.shader_variant(model, settings, count, points);
         self.scene_pass.prepare(gpu, variant);
 
         let mut encoder = gpu
@@ -395,12 +430,13 @@ impl SceneRenderer {
                 label: Some("scene frame"),
             });
         let draw_virtual = moved || self.lights_changed;
-        if draw_real && count > 0 {
+        let any_lights = count + points > 0;
+        if draw_real && any_lights {
             let t = self.timer.as_mut().and_then(|t| t.writes(0));
             self.shadows
                 .draw_real(gpu, &mut encoder, &self.gpu_scene, count, t);
         }
-        if draw_virtual && count > 0 {
+        if draw_virtual && any_lights {
             let t = self.timer.as_mut().and_then(|t| t.writes(1));
             self.shadows
                 .draw_virtual(gpu, &mut encoder, &self.gpu_scene, count, t);
@@ -433,8 +469,8 @@ impl SceneRenderer {
         self.drawn_placements = Some(placements);
         FrameReport {
             cpu_seconds: started.elapsed().as_secs_f64(),
-            drew_real_shadows: draw_real && count > 0,
-            drew_virtual_shadows: draw_virtual && count > 0,
+            drew_real_shadows: draw_real && any_lights,
+            drew_virtual_shadows: draw_virtual && any_lights,
         }
     }
 

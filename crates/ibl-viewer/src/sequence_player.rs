@@ -250,6 +250,7 @@ impl SequencePlayer {
             lights.extend(list.lights);
             return Ok(SceneLighting {
                 lights,
+                luminaires: Vec::new(),
                 ambient: None,
                 summary: format!(
                     "{sun} + the sky as {} shadowed median-cut lights, {sky} sky",
@@ -289,6 +290,7 @@ impl SequencePlayer {
         };
         Ok(SceneLighting {
             lights,
+            luminaires: Vec::new(),
             ambient: Some(ambient),
             summary: format!("{sun} + {source}, {sky} sky"),
         })

@@ -19,6 +19,10 @@
 //!
 //! Soft shadows widen each virtual tile by `1 + 2 tan a` (at most 3x) so a penumbra of cone
 //! half-angle `a` fits in it.
+//!
+//! Goniometric point lights take six tiles each after the directional lights' (their cube
+//! faces, `point_lights.rs`), drawn with the same rules: the real faces when the lights change,
+//! the virtual ones when an object moves, and only the faces that see casters.
 
 use glam::Vec3;
 use ibl_render::lighting::DirectionalLight;
@@ -27,6 +31,7 @@ use ibl_scene::ShadowKind;
 use crate::gpu::{DEPTH_FORMAT, GpuContext};
 use crate::gpu_scene::{GpuLight, GpuScene, vec4};
 use crate::light_space::{AtlasLayout, ShadowProjection, box_depths};
+use crate::point_lights::{FACES, FaceCasters, GpuPointLight, MAX_POINT_LIGHTS, gpu_point_lights};
 use crate::scene_geometry::{VERTEX_ATTRIBUTES, Vertex};
 
 /// The real atlas covers this many times the virtual objects' bounding radius about them.
@@ -120,15 +125,20 @@ pub struct ShadowAtlases {
     pub virtual_objects: Atlas,
     real_pipeline: wgpu::RenderPipeline,
     virtual_pipeline: wgpu::RenderPipeline,
+    /// Point lights' cube faces, both atlases (`vs_point_face`).
+    face_pipeline: wgpu::RenderPipeline,
     bind_layout: wgpu::BindGroupLayout,
+    /// The point lights as last fitted (their faces' tiles say which faces to draw).
+    points: Vec<GpuPointLight>,
     /// The region the real atlas covers now (`None`: never drawn).
     pub region: Option<Region>,
 }
 
 impl ShadowAtlases {
-    /// Atlases for `lights` lights of `tile` texels each (shrunk to fit the device).
-    pub fn new(gpu: &GpuContext, lights: u32, tile: u32) -> ShadowAtlases {
-        let layout = AtlasLayout::new(lights, tile, gpu.max_texture_side());
+    /// Atlases of `tiles` tiles (a directional light takes one, a point light [`FACES`]) of
+    /// `tile` texels each (shrunk to fit the device).
+    pub fn new(gpu: &GpuContext, tiles: u32, tile: u32) -> ShadowAtlases {
+        let layout = AtlasLayout::new(tiles, tile, gpu.max_texture_side());
         let device = &gpu.device;
         let source = format!(
             "{}\n{}",
@@ -170,6 +180,14 @@ impl ShadowAtlases {
                     },
                 ),
                 entry(2, storage),
+                entry(
+                    3,
+                    wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                ),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -213,7 +231,9 @@ impl ShadowAtlases {
             virtual_objects: Atlas::new(gpu, "virtual shadow atlas", layout),
             real_pipeline: pipeline("vs_real_tile"),
             virtual_pipeline: pipeline("vs_virtual_atlas"),
+            face_pipeline: pipeline("vs_point_face"),
             bind_layout,
+            points: Vec::new(),
             region: None,
         }
     }
@@ -223,21 +243,46 @@ impl ShadowAtlases {
         self.real.layout.tile
     }
 
-    /// How many lights the atlases hold tiles for.
+    /// How many tiles the atlases hold.
     pub fn capacity(&self) -> u32 {
         self.real.layout.tiles
     }
 
+    /// Tiles for `lights` directional and `points` point lights.
+    pub fn tiles_for(lights: usize, points: usize) -> u32 {
+        (lights + FACES * points.min(MAX_POINT_LIGHTS)).max(1) as u32
+    }
+
+    /// The point lights as last fitted.
+    pub fn point_lights(&self) -> &[GpuPointLight] {
+        &self.points
+    }
+
     /// The GPU lights: each light's tiles fitted to the scene (see the module notes). `objects`
     /// is the bounding sphere of the virtual objects now, `real_bounds` the real geometry's box.
-    /// Returns the lights and whether the real region moved (the real atlas must be redrawn).
+    /// The point lights' faces are fitted too (kept for drawing, [`Self::point_lights`]; their
+    /// strip of intensity maps has scale `map_scale`). Returns the directional lights and
+    /// whether the real region moved (the real atlas must be redrawn).
     pub fn fit(
         &mut self,
         lights: &[DirectionalLight],
+        points: &[ibl_light::GoniometricLight],
+        map_scale: f32,
         shadows: ShadowKind,
         objects: (Vec3, f32),
         real_bounds: Option<(Vec3, Vec3)>,
     ) -> (Vec<GpuLight>, bool) {
+        let casters = FaceCasters {
+            objects,
+            real: real_bounds.map(|(lo, hi)| bounding_sphere(lo, hi)),
+        };
+        self.points = gpu_point_lights(
+            points,
+            &self.real.layout,
+            lights.len() as u32,
+            casters,
+            map_scale,
+        );
         let (centre, radius) = objects;
         let region = match self.region {
             Some(r) if r.holds(centre, radius) => r,
@@ -312,6 +357,10 @@ impl ShadowAtlases {
                     binding: 2,
                     resource: scene.transforms.as_entire_binding(),
                 },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: scene.point_lights.as_entire_binding(),
+                },
             ],
         })
     }
@@ -339,7 +388,8 @@ impl ShadowAtlases {
         })
     }
 
-    /// Draws the real geometry into the real atlas, one tile per light.
+    /// Draws the real geometry into the real atlas, one tile per directional light, then the
+    /// point lights' faces.
     pub fn draw_real(
         &self,
         gpu: &GpuContext,
@@ -362,9 +412,49 @@ impl ShadowAtlases {
             pass.set_viewport(x as f32, y as f32, tile, tile, 0.0, 1.0);
             pass.draw(0..scene.real.vertices, i..i + 1);
         }
+        self.draw_faces(&mut pass, &self.real, 0, scene.real.vertices, |p| {
+            p.real_faces
+        });
     }
 
-    /// Draws the virtual objects into the virtual atlas, all lights in one instanced draw each.
+    /// Draws one caster (`object` 0 the real geometry, `k + 1` virtual object k) into every
+    /// point-light face of `atlas` that `faces` gives a tile, the viewport set to the tile.
+    fn draw_faces(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        atlas: &Atlas,
+        object: u32,
+        vertices: u32,
+        faces: impl Fn(&GpuPointLight) -> [[f32; 4]; FACES],
+    ) {
+        let (w, h) = atlas.size();
+        let mut bound = false;
+        for (k, light) in self.points.iter().enumerate() {
+            for (f, tile) in faces(light).iter().enumerate() {
+                if tile[2] == 0.0 {
+                    continue;
+                }
+                if !bound {
+                    pass.set_pipeline(&self.face_pipeline);
+                    bound = true;
+                }
+                pass.set_viewport(
+                    tile[0] * w as f32,
+                    tile[1] * h as f32,
+                    tile[2] * w as f32,
+                    tile[3] * h as f32,
+                    0.0,
+                    1.0,
+                );
+                let instance =
+                    (object * MAX_POINT_LIGHTS as u32 + k as u32) * FACES as u32 + f as u32;
+                pass.draw(0..vertices, instance..instance + 1);
+            }
+        }
+    }
+
+    /// Draws the virtual objects into the virtual atlas, all directional lights in one
+    /// instanced draw each, then the point lights' faces.
     pub fn draw_virtual(
         &self,
         gpu: &GpuContext,
@@ -380,11 +470,8 @@ impl ShadowAtlases {
             "virtual shadows",
             timestamps,
         );
+        let (w, h) = self.virtual_objects.size();
         let lights = lights.min(self.capacity());
-        if lights == 0 {
-            return;
-        }
-        pass.set_pipeline(&self.virtual_pipeline);
         pass.set_bind_group(0, &bind_group, &[]);
         for (k, mesh) in scene.objects.iter().enumerate() {
             if mesh.vertices == 0 {
@@ -392,7 +479,18 @@ impl ShadowAtlases {
             }
             let object = k as u32 + 1;
             pass.set_vertex_buffer(0, mesh.buffer.slice(..));
-            pass.draw(0..mesh.vertices, object * lights..(object + 1) * lights);
+            if lights > 0 {
+                pass.set_pipeline(&self.virtual_pipeline);
+                pass.set_viewport(0.0, 0.0, w as f32, h as f32, 0.0, 1.0);
+                pass.draw(0..mesh.vertices, object * lights..(object + 1) * lights);
+            }
+            self.draw_faces(
+                &mut pass,
+                &self.virtual_objects,
+                object,
+                mesh.vertices,
+                |p| p.virtual_faces,
+            );
         }
     }
 }

@@ -1,0 +1,115 @@
+// Goniometric point lights in the scene pass (point_lights.rs); prepended to scene_pass.wgsl
+// after shadow_lookup.wgsl. A point light's direct light at a surface point is Grosch 2005
+// EQ5 times the BSDF, `f cos(theta_i) I(-w_i) / d^2` (ibl-render's `luminaires`), with a hard
+// shadow from each layer: a point source casts no penumbra, and the CPU renderer traces one
+// shadow ray to it.
+//
+// The shadow look-up is hard_visibility's, in the cube face the receiver falls in: one
+// bilinear comparison tap, the receiver moved along its normal by 1.5 + 2 sin(theta) texels and
+// its distance along the face's axis lowered by 1 + 2 tan(theta) texels, a texel being
+// `2 z / tile` world units at distance z (a 90-degree face). The bias is applied to the
+// distance and the result mapped through face_depth, so it is linear in world units although
+// the stored depth is not.
+
+// The scene has point lights (frame.counts.y of them): a pipeline constant.
+override POINT_LIGHTS: bool = false;
+
+// Visibility of point light k (at `light`) through one atlas's face tiles, for a receiver at
+// p with unit normal n (lit side) and cos_light = n . (unit direction to the light).
+fn point_atlas_visibility(atlas: texture_depth_2d, atlas_size: vec2<f32>, k: u32, real: bool,
+                          light: vec3<f32>, p: vec3<f32>, n: vec3<f32>, cos_light: f32) -> f32 {
+    let near = point_lights[k].position.w;
+    let far = point_lights[k].shadow.x;
+    let texels = point_lights[k].shadow.y;
+    let cos_t = clamp(cos_light, 0.01, 1.0);
+    let sin_t = sqrt(1.0 - cos_t * cos_t);
+    let slope = min(sin_t / cos_t, 4.0);
+    let v0 = p - light;
+    let z0 = max(abs(v0.x), max(abs(v0.y), abs(v0.z)));
+    let texel_world = 2.0 * z0 / texels;
+    let v = v0 + n * ((1.5 + 2.0 * sin_t) * texel_world);
+    let face = face_of(v);
+    var tile = point_lights[k].virtual_faces[face];
+    if real {
+        tile = point_lights[k].real_faces[face];
+    }
+    if tile.z == 0.0 {
+        // No caster in this face.
+        return 1.0;
+    }
+    let q = face_coords(v, face);
+    let z = q.z - (1.0 + 2.0 * slope) * texel_world;
+    if z <= near {
+        // Nearer the light than any caster.
+        return 1.0;
+    }
+    let depth = min(face_depth(z, near, far), 1.0);
+    let uv = clamp_to_tile(tile_uv(tile, q.xy / q.z), tile, 1.0 / atlas_size);
+    return textureSampleCompareLevel(atlas, shadow_sampler, uv, depth);
+}
+
+// Visibility of point light k through the real geometry.
+fn point_real_visibility(k: u32, light: vec3<f32>, p: vec3<f32>, n: vec3<f32>, cos_light: f32) -> f32 {
+    if FLAT_REAL_LAYER {
+        // A point on the light's side of the plane (or on it) sees the light past the plane:
+        // no look-up (real_visibility's rule; the margin is two texels at this distance).
+        let plane = frame.real_plane;
+        let margin = 4.0 * length(p - light) / point_lights[k].shadow.y;
+        let side = (dot(plane.xyz, p) + plane.w) * sign(dot(plane.xyz, light) + plane.w);
+        if side >= -margin {
+            return 1.0;
+        }
+    }
+    return point_atlas_visibility(real_atlas, frame.atlas.xy, k, true, light, p, n, cos_light);
+}
+
+// The intensity of point light k towards world direction `travel` (from the light outwards),
+// probe units per sr: its table's map (point_lights.rs), bilinear in the photometric angles
+// (gamma from the nadir -y, C from +x towards -z, ibl-light's `angles_of_direction`).
+fn point_intensity(k: u32, travel: vec3<f32>) -> vec3<f32> {
+    let d = (point_lights[k].light_from_world * vec4<f32>(travel, 0.0)).xyz;
+    let gamma = atan2(length(d.xz), -d.y);
+    var c = atan2(-d.z, d.x) / (2.0 * PI);
+    c = c - floor(c);
+    let map = point_lights[k].map;
+    let half_row = 0.5 / f32(textureDimensions(intensity_maps).y);
+    let v = map.x + clamp(gamma / PI * map.y, half_row, map.y - half_row);
+    return textureSampleLevel(intensity_maps, probe_sampler, vec2<f32>(c, v), 0.0).rgb * map.z;
+}
+
+// Adds the point lights to a surface's sums: their direct light to a virtual object, and to a
+// real surface their whole light as a change (they are new lights, Grosch 2005 section 4.2:
+// the scene without the objects, which the background shows, has none of it).
+fn add_point_lights(m: Material, p: vec3<f32>, f: SurfaceFrame, wo: vec3<f32>, on_virtual: bool, sums_in: LightSums) -> LightSums {
+    var sums = sums_in;
+    let count = frame.counts.y;
+    for (var k = 0u; k < count; k = k + 1u) {
+        let light = point_lights[k].position.xyz;
+        let to_light = light - p;
+        let d2 = dot(to_light, to_light);
+        if d2 <= 0.0 {
+            continue;
+        }
+        let wi = to_light * inverseSqrt(d2);
+        // A new light lights glossy lobes too: the probe's reflection does not hold it.
+        let fc = reflection(m, f.ns, f.ng, wo, wi, true);
+        if all(fc <= vec3<f32>(0.0)) {
+            continue;
+        }
+        let intensity = point_intensity(k, -wi);
+        if all(intensity <= vec3<f32>(0.0)) {
+            continue;
+        }
+        let cos_light = dot(f.ng, wi);
+        let visible = point_atlas_visibility(virtual_atlas, frame.atlas.zw, k, false, light, p, f.ng, cos_light)
+            * point_real_visibility(k, light, p, f.ng, cos_light);
+        let e = fc * intensity * (visible / d2);
+        if on_virtual {
+            sums.direct = sums.direct + e;
+        } else {
+            sums.affected = true;
+            sums.change = sums.change + e;
+        }
+    }
+    return sums;
+}
