@@ -655,6 +655,63 @@ fn a_bad_edits_file_in_the_viewer_is_refused_with_status_2() {
         ],
         "missing.toml",
     );
+    // The live display draws the objects an edits file inserts: a file with none is refused.
+    refuses(
+        &[
+            "view",
+            &probe,
+            "--room",
+            &room,
+            "--edit",
+            &edits,
+            "--live",
+            "--headless",
+        ],
+        "inserts no [[object]]",
+    );
+}
+
+#[test]
+fn the_live_display_draws_the_edits_objects_in_the_room() {
+    // `--live`: the bunny of edits-object.toml drawn by the GPU in the room (crates/ibl-viewer/
+    // tests/room_live.rs compares it with `ibl room render`); here the command line: the
+    // summary names the display and the frame is the scene camera's.
+    let dir = tempfile::tempdir().unwrap();
+    let apartment = repo().join("assets/rooms/apartment");
+    let png = dir.path().join("live.png");
+    let out = ibl(&[
+        "view",
+        &common::probe("apartment.exr"),
+        "--room",
+        apartment.join("room.toml").to_str().unwrap(),
+        "--edit",
+        apartment.join("edits-object.toml").to_str().unwrap(),
+        "--live",
+        "--headless",
+        "--size",
+        "160x120",
+        "-o",
+        png.to_str().unwrap(),
+        "--json",
+    ]);
+    if no_adapter(&out, "live display") {
+        return;
+    }
+    assert!(out.status.success(), "{}", stderr(&out));
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let lighting = v["lighting"].as_str().unwrap();
+    assert!(
+        lighting.contains("improved display") && lighting.contains("32 important patches"),
+        "{lighting}"
+    );
+    assert_eq!(
+        (v["width"].as_u64(), v["height"].as_u64()),
+        (Some(160), Some(120))
+    );
+    let frame = ibl_io::read_image(&dir.path().join("live.exr"))
+        .unwrap()
+        .image;
+    assert_eq!((frame.width(), frame.height()), (160, 120));
 }
 
 #[test]

@@ -69,6 +69,7 @@ pub mod progress;
 pub mod progress_lines;
 pub mod render;
 pub mod room_calibrate;
+pub mod room_display;
 pub mod room_estimate;
 pub mod room_input;
 pub mod room_lights;

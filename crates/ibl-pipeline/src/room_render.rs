@@ -59,10 +59,10 @@ use ibl_io::luminaire_file::read_luminaire;
 use ibl_light::GoniometricLight;
 use ibl_room::room_radiance::RoomRadiance;
 use ibl_room::{
-    DisplayMode, FillTexture, FillTextureSettings, Group, GroupKind, HoleFill,
-    LightAdditionSettings, MaterialChange, NovelViewSettings, ObjectDisplay, ObjectDisplaySettings,
-    Room, RoomVolume, VolumeSettings, add_lights, change_materials, important_patches,
-    render_novel_view,
+    DisplayMode, FillTexture, FillTextureSettings, Group, GroupKind, HoleFill, ImportantLights,
+    LightAddition, LightAdditionSettings, MaterialChange, MaterialEdit, NovelViewSettings,
+    ObjectDisplay, ObjectDisplaySettings, Room, RoomVolume, VolumeSettings, add_lights,
+    change_materials, important_patches, render_novel_view,
 };
 use ibl_scene::description::{GeometryDescription, IntensityScale, LuminaireDescription};
 use ibl_scene::{Camera, GeometryLayer};
@@ -687,17 +687,62 @@ impl EditedPictures {
     }
 }
 
-/// Applies `edits` to `estimated` (the room file `room_path`, for messages), with what the edits
-/// name as `assets` ([`RoomEdits::load`]), and renders the pictures before and after.
-pub fn render_edits(
+/// A room with an edits file's material changes and new lights applied (no objects yet).
+#[derive(Clone, Debug)]
+pub struct EditedRoom {
+    /// The changed groups, with their reflectance before and after.
+    pub rows: Vec<MaterialRow>,
+    /// The material change and its colour bleeding (per patch: `reflectance`, `radiosity`).
+    pub edit: MaterialEdit,
+    /// The new lights' direct light and bounces (none without new lights).
+    pub addition: Option<LightAddition>,
+    /// The probe with the edited materials (the lights are added at each point shown).
+    pub edited_probe: Image<Rgb>,
+    /// The estimate with the edit's radiosity.
+    pub estimate: ibl_room::Estimate,
+    /// Seconds of the edit.
+    pub seconds_edit: f64,
+}
+
+impl EditedRoom {
+    /// The edited room as a radiance field: the edited probe's texture, the edited estimate, the
+    /// new lights' light (what a moved camera and the objects' volume see).
+    pub fn radiance<'a>(&'a self, estimated: &'a EstimatedRoom) -> Result<RoomRadiance<'a>> {
+        let analysis = &estimated.analysis;
+        let field = RoomRadiance::new(
+            &estimated.input.room,
+            &analysis.depth,
+            &self.edited_probe,
+            &self.estimate,
+        )?;
+        Ok(match &self.addition {
+            Some(a) => field.with_added_light(a),
+            None => field,
+        })
+    }
+
+    /// The edited panorama as the probe shows it, with the new lights' light (no objects).
+    pub fn panorama(&self, estimated: &EstimatedRoom) -> Result<Image<Rgb>> {
+        Ok(match &self.addition {
+            Some(a) => a.panorama(
+                &estimated.input.room,
+                &estimated.analysis.depth,
+                &self.edited_probe,
+            )?,
+            None => self.edited_probe.clone(),
+        })
+    }
+}
+
+/// Applies `edits`'s material changes and new lights (`assets.lights`) to `estimated` (the room
+/// file `room_path`, for messages).
+pub fn edit_room(
     estimated: &EstimatedRoom,
     edits: &RoomEdits,
     assets: &EditAssets,
     room_path: &Path,
-) -> Result<EditedPictures> {
-    let lights = &assets.lights;
+) -> Result<EditedRoom> {
     let (changes, rows) = resolve_materials(estimated, edits, room_path)?;
-
     let start = Instant::now();
     let room = &estimated.input.room;
     let analysis = &estimated.analysis;
@@ -709,14 +754,14 @@ pub fn render_edits(
         edits.bounces,
     )?;
     // The new lights reflect off the edited materials and bounce as often as their change.
-    let addition = if lights.is_empty() {
+    let addition = if assets.lights.is_empty() {
         None
     } else {
         let settings = LightAdditionSettings {
             bounces: edits.bounces,
             ..LightAdditionSettings::default()
         };
-        let placed = lights.iter().map(|l| l.light.clone()).collect();
+        let placed = assets.lights.iter().map(|l| l.light.clone()).collect();
         Some(add_lights(
             room,
             &edit.reflectance,
@@ -725,24 +770,58 @@ pub fn render_edits(
             &settings,
         )?)
     };
-    // The probe with the edited materials: the texture a moved camera sees (the lights are
-    // added at each point it shows).
+    // The probe with the edited materials: the texture a moved camera sees.
     let edited_probe = edit.panorama(&analysis.depth, &estimated.probe)?;
-    let seconds_edit = start.elapsed().as_secs_f64();
-
-    let start = Instant::now();
-    // The edited room as a radiance field: the edited probe's texture, the edited estimate, the
-    // new lights' light (what a moved camera and the objects' volume see).
     let estimate = edited_estimate(estimated, &edit.radiosity);
-    let field = RoomRadiance::new(room, &analysis.depth, &edited_probe, &estimate)?;
-    let field = match &addition {
-        Some(a) => field.with_added_light(a),
-        None => field,
-    };
+    Ok(EditedRoom {
+        rows,
+        edit,
+        addition,
+        edited_probe,
+        estimate,
+        seconds_edit: start.elapsed().as_secs_f64(),
+    })
+}
+
+/// The objects' lights in an edited room (`field`, its `estimate`): the `n` important patches
+/// and the irradiance volume gathered with them left out of its second layer (Grosch 2005
+/// section 4.1).
+pub fn object_lighting(
+    field: &RoomRadiance,
+    estimate: &ibl_room::Estimate,
+    n: usize,
+) -> Result<(ImportantLights, RoomVolume)> {
+    let important = important_patches(field.room(), estimate, n);
+    let volume = RoomVolume::build(field, &important, &VolumeSettings::default())?;
+    Ok((important, volume))
+}
+
+/// Applies `edits` to `estimated` (the room file `room_path`, for messages), with what the edits
+/// name as `assets` ([`RoomEdits::load`]), and renders the pictures before and after.
+pub fn render_edits(
+    estimated: &EstimatedRoom,
+    edits: &RoomEdits,
+    assets: &EditAssets,
+    room_path: &Path,
+) -> Result<EditedPictures> {
+    let lights = &assets.lights;
+    let room = &estimated.input.room;
+    let analysis = &estimated.analysis;
+    let edited = edit_room(estimated, edits, assets, room_path)?;
+    let EditedRoom {
+        rows,
+        edit,
+        addition,
+        estimate,
+        seconds_edit,
+        ..
+    } = &edited;
+    let start = Instant::now();
+    let field = edited.radiance(estimated)?;
     let lamps: Vec<GoniometricLight> = lights.iter().map(|l| l.light.clone()).collect();
     let objects = assets.objects.as_ref().map(|objects| ObjectInputs {
         field: &field,
-        estimate: &estimate,
+        estimate,
         reflectance: &edit.reflectance,
         objects,
         lamps: &lamps,
@@ -750,10 +829,7 @@ pub fn render_edits(
     });
     let (before, after, filled_fraction) = match &edits.view {
         None => {
-            let lit = match &addition {
-                Some(a) => a.panorama(room, &analysis.depth, &edited_probe)?,
-                None => edited_probe.clone(),
-            };
+            let lit = edited.panorama(estimated)?;
             let after = match &objects {
                 Some(o) => o.display(|d| Ok(d.panorama(&lit)?.image))?,
                 None => lit,
@@ -816,7 +892,7 @@ pub fn render_edits(
         before,
         after,
         report: EditReport {
-            materials: rows,
+            materials: rows.clone(),
             lights: lights.iter().map(|l| l.row.clone()).collect(),
             objects: assets.objects.as_ref().map(|o| ObjectRow {
                 names: o.object_names.clone(),
@@ -830,7 +906,7 @@ pub fn render_edits(
             bounces: edit.bounces,
             last_bounce_relative,
             filled_fraction,
-            seconds_edit,
+            seconds_edit: *seconds_edit,
             seconds_render: start.elapsed().as_secs_f64(),
         },
     })
@@ -859,10 +935,8 @@ impl ObjectInputs<'_> {
     /// Builds the display (the important patches, the irradiance volume of the edited room,
     /// Grosch's display with the new lights) and hands it to `picture`.
     fn display<R>(&self, picture: impl FnOnce(&ObjectDisplay) -> Result<R>) -> Result<R> {
-        let room = self.field.room();
-        let important = important_patches(room, self.estimate, self.edits.important_patches);
-        let volume: RoomVolume =
-            RoomVolume::build(self.field, &important, &VolumeSettings::default())?;
+        let (important, volume) =
+            object_lighting(self.field, self.estimate, self.edits.important_patches)?;
         let settings = ObjectDisplaySettings {
             mode: self.edits.display,
             ..ObjectDisplaySettings::default()

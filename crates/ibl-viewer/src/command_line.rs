@@ -164,6 +164,12 @@ pub struct ViewArgs {
     /// the edited panorama is shown instead of the probe.
     #[arg(long, value_name = "EDITS.toml", requires = "room")]
     pub edit: Option<PathBuf>,
+    /// Draw the --edit file's objects live on the GPU, in the room as the real layer, with
+    /// Grosch's display the file names (fast or improved): they can be dragged, every patch's
+    /// shadow following. The frame is the scene camera's: the file's [view], or from the
+    /// probe's centre towards the objects.
+    #[arg(long, requires = "edit")]
+    pub live: bool,
     /// An outdoor sequence's sky as N shadowed median-cut lights (a power of two; 0: the
     /// unshadowed SH ambient): the objects' sky shadow, one shadow map per light.
     #[arg(long, value_name = "N", default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=64))]
@@ -189,6 +195,7 @@ impl ViewArgs {
             marks: self.marks.clone(),
             room: self.room.clone(),
             edit: self.edit.clone(),
+            live: self.live,
         }
     }
 }

@@ -38,6 +38,10 @@ pub struct FrameUniform {
     pub atlas: [f32; 4],
     /// The flat real layer's plane `(n, d)`, `n . p + d = 0` (zero when it is not flat).
     pub real_plane: [f32; 4],
+    /// The objects' occluding sphere (centre, radius), zero without the gather.
+    pub occluder: [f32; 4],
+    /// Their mean diffuse albedo.
+    pub occluder_albedo: [f32; 4],
 }
 
 /// `Light` of `gpu_scene.wgsl`.
@@ -295,7 +299,7 @@ mod tests {
     #[test]
     fn structs_match_their_wgsl_sizes() {
         // Sums of the WGSL members (all 16-byte columns): no padding on either side.
-        assert_eq!(std::mem::size_of::<FrameUniform>(), 3 * 64 + 8 * 16);
+        assert_eq!(std::mem::size_of::<FrameUniform>(), 3 * 64 + 10 * 16);
         assert_eq!(std::mem::size_of::<GpuLight>(), 2 * 64 + 6 * 16);
         assert_eq!(std::mem::size_of::<GpuObject>(), 2 * 64 + 16);
         assert_eq!(std::mem::size_of::<GpuMaterial>(), 32);

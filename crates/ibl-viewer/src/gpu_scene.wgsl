@@ -26,6 +26,11 @@ struct Frame {
     atlas: vec4<f32>,
     // The flat real layer's plane (n, d), n . p + d = 0; zero when the real layer is not flat.
     real_plane: vec4<f32>,
+    // The virtual objects as one sphere of their mean cross-section (centre, radius) and their
+    // mean diffuse albedo (rgb): the occlusion gather on real surfaces (scene_pass.wgsl's
+    // `occluder_change`); zero when the scene has none.
+    occluder: vec4<f32>,
+    occluder_albedo: vec4<f32>,
 };
 
 // Lights a frame draws (gpu_scene.rs's MAX_SHADOWED_LIGHTS): a uniform array of this many.

@@ -233,8 +233,21 @@ pub fn render_scene(
     options: &HeadlessOptions,
     progress: &dyn Fn(usize, usize),
 ) -> Result<HeadlessRun, ViewerError> {
-    let (w, h) = options.size;
     let (lighting, lighting_seconds) = lights_now(model)?;
+    render_scene_lit(gpu, model, lighting, lighting_seconds, options, progress)
+}
+
+/// [`render_scene`] with lights made elsewhere (`lighting`, made in `lighting_seconds`): a
+/// room's live display, whose lights are the room's.
+pub fn render_scene_lit(
+    gpu: &GpuContext,
+    model: &SceneModel,
+    lighting: SceneLighting,
+    lighting_seconds: f64,
+    options: &HeadlessOptions,
+    progress: &dyn Fn(usize, usize),
+) -> Result<HeadlessRun, ViewerError> {
+    let (w, h) = options.size;
     let lights = lighting.lights.len();
     let summary = lighting.summary.clone();
     let mut renderer = SceneRenderer::new(gpu, model, w, h, options.shadow_tile)?;

@@ -62,6 +62,7 @@ pub mod probe_model;
 pub mod probe_pass;
 pub mod probe_renderer;
 pub mod room_edit;
+pub mod room_live;
 pub mod room_marking;
 pub mod room_overlay;
 pub mod room_panel;

@@ -38,6 +38,21 @@ pub struct SceneLighting {
     /// The goniometric point lights (a scene's `[[luminaire]]` entries: the CPU renderer's
     /// `Lighting::luminaires`, `point_lights.rs`).
     pub luminaires: Vec<ibl_light::GoniometricLight>,
+    /// Whether the luminaires' light is already in the background (a room's important patches
+    /// and placed lights): then on real surfaces they only cast the objects' shadows; else they
+    /// are new lights, whose whole light joins the background.
+    pub luminaires_in_background: bool,
+    /// Whether the luminaires light the virtual objects (not in Grosch's fast display, whose
+    /// objects take all their light from the irradiance volume).
+    pub luminaires_light_objects: bool,
+    /// Per luminaire, the least squared distance its `1 / d^2` counts, m^2 (a room's patch as a
+    /// point: its area, as `ibl_room::ObjectDisplay` bounds a patch's near field); missing
+    /// entries are 0 (a point lamp).
+    pub luminaire_near_field_m2: Vec<f32>,
+    /// Whether real surfaces lose the ambient light the objects hide from them (the improved
+    /// display's differential gather, approximated by the objects' occluding sphere:
+    /// `scene_pass.wgsl`'s `occluder_change`).
+    pub occlusion_gather: bool,
     /// Hybrid mode: the ambient's irradiance `E(n)` on a world-frame lat-long grid.
     pub ambient: Option<Image<Rgb>>,
     /// A short description: `16 median-cut lights`, `8 lightgen lights + SH9 ambient`.
@@ -93,6 +108,10 @@ pub fn scene_lighting(request: &SceneLightingRequest) -> Result<SceneLighting, S
     Ok(SceneLighting {
         lights: list.lights.clone(),
         luminaires: lighting.luminaires.clone(),
+        luminaires_in_background: false,
+        luminaires_light_objects: true,
+        luminaire_near_field_m2: Vec::new(),
+        occlusion_gather: false,
         ambient: ambient
             .as_ref()
             .map(|sh| irradiance_map(sh, IRRADIANCE_MAP_WIDTH)),

@@ -215,6 +215,19 @@ fn scene_panel(ui: &mut egui::Ui, s: &mut SceneState, gpu_changed: &mut bool) {
         object_panel(ui, s, gpu_changed);
         return;
     }
+    if s.fixed_lighting {
+        // A room's live display: its lights are the room's (crate::room_live).
+        if let Some(l) = s.renderer_lighting_summary() {
+            ui.label(l);
+        }
+        ui.separator();
+        ui.label("Display");
+        let automatic = crate::headless::auto_exposure(&s.model);
+        display_controls(ui, &mut s.display, automatic);
+        ui.separator();
+        object_panel(ui, s, gpu_changed);
+        return;
+    }
     ui.label("Lighting");
     let d = &mut s.model.description;
     let mut mode = match d.render.mode {
@@ -471,8 +484,8 @@ pub fn side_panel(ui: &mut egui::Ui, content: &mut Content) -> PanelRequests {
                 ui.separator();
                 ui.horizontal(|ui| {
                     requests.save_frame = ui.button("save frame (F12)").clicked();
-                    requests.save_scene =
-                        matches!(content, Content::Scene(_)) && ui.button("save scene").clicked();
+                    requests.save_scene = matches!(content, Content::Scene(s) if !s.fixed_lighting)
+                        && ui.button("save scene").clicked();
                 });
             });
         });
@@ -500,8 +513,13 @@ pub fn status_bar(ui: &mut egui::Ui, content: &Content, status: StatusLine<'_>) 
             match content {
                 Content::Scene(s) => {
                     let lights = s.lighting().map_or(0, |l| l.lights.len());
+                    let points = s.lighting().map_or(0, |l| l.luminaires.len());
+                    let points = match points {
+                        0 => String::new(),
+                        n => format!(" + {n} point lights"),
+                    };
                     ui.label(format!(
-                        "{lights} lights, shadow maps {}^2",
+                        "{lights} lights{points}, shadow maps {}^2",
                         s.drawn_shadow_tile()
                     ));
                     if let Some(t) = s.pass_times() {

@@ -49,11 +49,13 @@ pub const MAP_HEIGHT: usize = 128;
 pub struct GpuPointLight {
     /// xyz: world position; w: the faces' near plane (world units).
     pub position: [f32; 4],
-    /// x: the faces' far plane; y: a face tile's side, texels.
+    /// x: the faces' far plane; y: a face tile's side, texels; z: 1 when the light is already
+    /// in the background (else a new light); w: 1 when it lights the virtual objects.
     pub shadow: [f32; 4],
     /// Rotation from world to the photometric frame (columns).
     pub light_from_world: [[f32; 4]; 4],
-    /// Rows of its map in the strip (v0, dv, texture coordinates) and the strip's scale.
+    /// Rows of its map in the strip (v0, dv, texture coordinates), the strip's scale and the
+    /// least squared distance counted (m^2, 0 for a point lamp).
     pub map: [f32; 4],
     /// Face tiles in the real atlas (u0, v0, du, dv), zero where the face sees no caster.
     pub real_faces: [[f32; 4]; FACES],
@@ -107,6 +109,28 @@ pub fn depth_range(light: Vec3, centre: Vec3, radius: f32) -> (f32, f32) {
     (near, far)
 }
 
+/// How a frame's point lights take part in the composite.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PointLightRole {
+    /// Their light is already in the background (see `SceneLighting::luminaires_in_background`).
+    pub in_background: bool,
+    /// They light the virtual objects.
+    pub light_objects: bool,
+}
+
+/// A frame's point lights as the atlases fit them.
+#[derive(Clone, Copy, Debug)]
+pub struct PointLightInputs<'a> {
+    /// The lights.
+    pub lights: &'a [GoniometricLight],
+    /// The scale of their strip of intensity maps (its texels times this are intensities).
+    pub map_scale: f32,
+    /// How they take part in the composite.
+    pub role: PointLightRole,
+    /// Per light, the least squared distance counted, m^2 (missing: 0).
+    pub near_field_m2: &'a [f32],
+}
+
 /// What the faces of a frame's point lights are fitted to.
 #[derive(Clone, Copy, Debug)]
 pub struct FaceCasters {
@@ -116,15 +140,21 @@ pub struct FaceCasters {
     pub real: Option<(Vec3, f32)>,
 }
 
-/// The GPU records of `lights`, their faces in tiles `first_tile + 6 k + f` of `layout`, the
-/// strip's scale `map_scale` (its texels times this are intensities).
+/// The GPU records of `inputs.lights`, their faces in tiles `first_tile + 6 k + f` of
+/// `layout`, fitted to `casters`.
 pub fn gpu_point_lights(
-    lights: &[GoniometricLight],
+    inputs: &PointLightInputs<'_>,
     layout: &AtlasLayout,
     first_tile: u32,
     casters: FaceCasters,
-    map_scale: f32,
 ) -> Vec<GpuPointLight> {
+    let PointLightInputs {
+        lights,
+        map_scale,
+        role,
+        near_field_m2,
+    } = *inputs;
+    let flag = |b: bool| if b { 1.0 } else { 0.0 };
     let strip_rows = lights.len().max(1) as f32;
     lights
         .iter()
@@ -159,9 +189,19 @@ pub fn gpu_point_lights(
             });
             GpuPointLight {
                 position: vec4(p, near),
-                shadow: [far, layout.tile as f32, 0.0, 0.0],
+                shadow: [
+                    far,
+                    layout.tile as f32,
+                    flag(role.in_background),
+                    flag(role.light_objects),
+                ],
                 light_from_world: mat3_columns(light.world_from_light.transpose()),
-                map: [k as f32 / strip_rows, 1.0 / strip_rows, map_scale, 0.0],
+                map: [
+                    k as f32 / strip_rows,
+                    1.0 / strip_rows,
+                    map_scale,
+                    near_field_m2.get(k).copied().unwrap_or(0.0).max(0.0),
+                ],
                 real_faces,
                 virtual_faces,
             }

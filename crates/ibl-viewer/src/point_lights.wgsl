@@ -77,13 +77,26 @@ fn point_intensity(k: u32, travel: vec3<f32>) -> vec3<f32> {
     return textureSampleLevel(intensity_maps, probe_sampler, vec2<f32>(c, v), 0.0).rgb * map.z;
 }
 
-// Adds the point lights to a surface's sums: their direct light to a virtual object, and to a
-// real surface their whole light as a change (they are new lights, Grosch 2005 section 4.2:
-// the scene without the objects, which the background shows, has none of it).
+// What point light k gives a surface point with BSDF term `fc` (f cos theta_i) from distance
+// squared d2 along wi: I(-wi) fc / max(d2, its near-field bound map.w), unshadowed.
+fn point_light_term(k: u32, fc: vec3<f32>, wi: vec3<f32>, d2: f32) -> vec3<f32> {
+    return fc * point_intensity(k, -wi) / max(d2, point_lights[k].map.w);
+}
+
+// Adds the point lights to a surface's sums. A new light (Grosch 2005 section 4.2: the scene
+// without the objects, which the background shows, has none of its light) gives a real
+// surface its whole light as a change; a light already in the background (a room's important
+// patch, shadow.z = 1) gives it only the objects' shadow, `with - without` as for the
+// directional lights (Grosch's `dL_i = rho E_i / pi` where the objects block it). A virtual
+// object takes the light unless shadow.w = 0 (Grosch's fast display).
 fn add_point_lights(m: Material, p: vec3<f32>, f: SurfaceFrame, wo: vec3<f32>, on_virtual: bool, sums_in: LightSums) -> LightSums {
     var sums = sums_in;
     let count = frame.counts.y;
     for (var k = 0u; k < count; k = k + 1u) {
+        let in_background = point_lights[k].shadow.z > 0.5;
+        if on_virtual && point_lights[k].shadow.w < 0.5 {
+            continue;
+        }
         let light = point_lights[k].position.xyz;
         let to_light = light - p;
         let d2 = dot(to_light, to_light);
@@ -96,20 +109,52 @@ fn add_point_lights(m: Material, p: vec3<f32>, f: SurfaceFrame, wo: vec3<f32>, o
         if all(fc <= vec3<f32>(0.0)) {
             continue;
         }
-        let intensity = point_intensity(k, -wi);
-        if all(intensity <= vec3<f32>(0.0)) {
+        let cos_light = dot(f.ng, wi);
+        let vv = point_atlas_visibility(virtual_atlas, frame.atlas.zw, k, false, light, p, f.ng, cos_light);
+        if !on_virtual && in_background && vv >= 1.0 {
+            // Not shadowed by the objects: with and without agree.
             continue;
         }
-        let cos_light = dot(f.ng, wi);
-        let visible = point_atlas_visibility(virtual_atlas, frame.atlas.zw, k, false, light, p, f.ng, cos_light)
-            * point_real_visibility(k, light, p, f.ng, cos_light);
-        let e = fc * intensity * (visible / d2);
+        let e = point_light_term(k, fc, wi, d2);
+        if all(e <= vec3<f32>(0.0)) {
+            continue;
+        }
+        let lit = e * point_real_visibility(k, light, p, f.ng, cos_light);
         if on_virtual {
-            sums.direct = sums.direct + e;
+            sums.direct = sums.direct + lit * vv;
+        } else if in_background {
+            sums.affected = true;
+            sums.change = sums.change + lit * (vv - 1.0);
         } else {
             sums.affected = true;
-            sums.change = sums.change + e;
+            sums.change = sums.change + lit * vv;
         }
     }
     return sums;
+}
+
+// The ratio rule's `without` on a real surface from the point lights already in the
+// background: their light with the real layer's shadows only.
+fn point_lights_without(m: Material, p: vec3<f32>, f: SurfaceFrame, wo: vec3<f32>) -> vec3<f32> {
+    var without = vec3<f32>(0.0);
+    let count = frame.counts.y;
+    for (var k = 0u; k < count; k = k + 1u) {
+        if point_lights[k].shadow.z < 0.5 {
+            continue;
+        }
+        let light = point_lights[k].position.xyz;
+        let to_light = light - p;
+        let d2 = dot(to_light, to_light);
+        if d2 <= 0.0 {
+            continue;
+        }
+        let wi = to_light * inverseSqrt(d2);
+        let fc = reflection(m, f.ns, f.ng, wo, wi, true);
+        if all(fc <= vec3<f32>(0.0)) {
+            continue;
+        }
+        without = without + point_light_term(k, fc, wi, d2)
+            * point_real_visibility(k, light, p, f.ng, dot(f.ng, wi));
+    }
+    return without;
 }

@@ -102,6 +102,34 @@ impl SceneModel {
         })
     }
 
+    /// A scene made in memory rather than read from a file (a room's live display,
+    /// `ibl_pipeline::room_display`): `description` and `scene` as the scene reader would give
+    /// them, `path` the file it stands for (messages; saving is the front end's to refuse).
+    pub fn from_parts(
+        path: &Path,
+        description: SceneDescription,
+        scene: Scene,
+        inputs: Vec<PathBuf>,
+    ) -> SceneModel {
+        let geometry = SceneGeometry::from_scene(&scene);
+        let load_placements = description
+            .object
+            .iter()
+            .map(GeometryDescription::world_from_model)
+            .collect();
+        SceneModel {
+            path: path.to_path_buf(),
+            text: String::new(),
+            original: description.clone(),
+            description,
+            scene: Arc::new(scene),
+            geometry,
+            load_placements,
+            inputs,
+            given_lights: None,
+        }
+    }
+
     /// Number of virtual objects.
     pub fn object_count(&self) -> usize {
         self.description.object.len()

@@ -44,10 +44,13 @@ pub struct ShaderVariant {
     pub tiled_lights: bool,
     /// The scene has goniometric point lights (`point_lights.rs`).
     pub point_lights: bool,
+    /// Real surfaces lose the ambient light the objects' occluding sphere hides
+    /// (`FrameUniform::occluder`).
+    pub occlusion_gather: bool,
 }
 
 impl ShaderVariant {
-    fn constants(&self) -> [(&'static str, f64); 9] {
+    fn constants(&self) -> [(&'static str, f64); 10] {
         let flag = |b: bool| if b { 1.0 } else { 0.0 };
         [
             ("SOFT_SHADOWS", flag(self.soft_shadows)),
@@ -62,6 +65,7 @@ impl ShaderVariant {
             ("FLAT_REAL_LAYER", flag(self.flat_real_layer)),
             ("TILED_LIGHTS", flag(self.tiled_lights)),
             ("POINT_LIGHTS", flag(self.point_lights)),
+            ("OCCLUSION_GATHER", flag(self.occlusion_gather)),
         ]
     }
 }

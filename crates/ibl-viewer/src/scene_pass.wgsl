@@ -78,6 +78,8 @@ override HAS_AMBIENT: bool = false;
 override BACKGROUND_RAYS: u32 = 4u;
 // Real surfaces take only their screen tile's lights (light_tiles.wgsl; else every light).
 override TILED_LIGHTS: bool = false;
+// Real surfaces lose the ambient light the objects hide (frame.occluder, `occluder_change`).
+override OCCLUSION_GATHER: bool = false;
 
 struct GeometryOut {
     @builtin(position) clip: vec4<f32>,
@@ -332,6 +334,32 @@ fn shade_virtual(m: Material, f: SurfaceFrame, wo: vec3<f32>, sums: LightSums) -
     return radiance;
 }
 
+// The change in a real surface point's radiance from the ambient light the virtual objects
+// hide from it, the improved display's differential gather (docs/ROOMS.md section 13) with the
+// objects taken as one sphere of their mean cross-section (frame.occluder): the sphere covers
+// a cone of half-angle a (sin a = r / d) towards its centre c, whose cosine-weighted solid angle
+// is pi sin^2(a) (n . c) while it stands above the horizon. Through it the point no longer sees
+// the room beyond, radiance E(c) / pi (the ambient map at the objects: the light arriving there
+// from beyond them), but the objects' own ambient-lit side, rho_o E(-c) / pi, so
+// `dE = sin^2(a) (n . c) (rho_o E(-c) - E(c))` and the radiance changes by `rho dE / pi`.
+fn occluder_change(m: Material, p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    let o = frame.occluder;
+    let to_centre = o.xyz - p;
+    let d2 = dot(to_centre, to_centre);
+    if o.w <= 0.0 || d2 <= 0.0 {
+        return vec3<f32>(0.0);
+    }
+    let c = to_centre * inverseSqrt(d2);
+    let cos_n = dot(n, c);
+    if cos_n <= 0.0 {
+        return vec3<f32>(0.0);
+    }
+    let cover = min(o.w * o.w / d2, 1.0);
+    let hidden = ambient_irradiance(c);
+    let seen = frame.occluder_albedo.rgb * ambient_irradiance(-c);
+    return m.albedo_kind.rgb / PI * (cover * cos_n) * (seen - hidden);
+}
+
 // The composite on a real surface (module notes).
 fn composite_real(m: Material, p: vec3<f32>, f: SurfaceFrame, wo: vec3<f32>, b: vec3<f32>, sums: LightSums, pixel_noise: f32) -> vec3<f32> {
     let change = sums.change;
@@ -350,6 +378,9 @@ fn composite_real(m: Material, p: vec3<f32>, f: SurfaceFrame, wo: vec3<f32>, b: 
             continue;
         }
         without = without + fc * lights[i].irradiance.rgb * real_visibility(i, p, f.ng, pixel_noise);
+    }
+    if POINT_LIGHTS {
+        without = without + point_lights_without(m, p, f, wo);
     }
     let lit = without + change;
     var out = vec3<f32>(0.0);
@@ -442,6 +473,13 @@ fn shade_surface(s: Surface, pixel: vec2<f32>, pixel_noise: f32, mask_base: u32)
     var sums = light_sums(m, s.p, f, wo, on_virtual, pixel_noise, mask_base);
     if POINT_LIGHTS {
         sums = add_point_lights(m, s.p, f, wo, on_virtual, sums);
+    }
+    if OCCLUSION_GATHER && !on_virtual {
+        let gathered = occluder_change(m, s.p, f.ns);
+        if any(gathered != vec3<f32>(0.0)) {
+            sums.affected = true;
+            sums.change = sums.change + gathered;
+        }
     }
     if on_virtual {
         return shade_virtual(m, f, wo, sums);

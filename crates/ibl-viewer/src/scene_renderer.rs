@@ -87,6 +87,9 @@ pub struct SceneRenderer {
     /// The real geometry's plane when it is flat (`SceneGeometry::real_plane`; real geometry
     /// never changes after load, so it is found once).
     real_plane: Option<(Vec3, f32)>,
+    /// The radius of the sphere of the objects' mean cross-section as a fraction of their
+    /// bounding sphere's ([`occluding_fraction`]; found once, at load).
+    occluding_fraction: f32,
     /// Pass times of the latest frame whose timestamps were read.
     pub last_pass_times: Option<PassTimes>,
     /// The photo background set by [`SceneRenderer::set_photo`] (a sequence's frame), at its
@@ -182,6 +185,7 @@ impl SceneRenderer {
             lights_changed: true,
             timer: PassTimer::new(gpu, &SCENE_PASSES),
             real_plane: model.geometry.real_plane(),
+            occluding_fraction: occluding_fraction(model),
             last_pass_times: None,
             photo_source: None,
         })
@@ -327,6 +331,13 @@ impl SceneRenderer {
             real_plane: self
                 .real_plane
                 .map_or([0.0; 4], |(n, d)| [n.x, n.y, n.z, d]),
+            occluder: self
+                .occluder(model)
+                .map_or([0.0; 4], |(c, r)| [c.x, c.y, c.z, r]),
+            occluder_albedo: {
+                let a = objects_albedo(model);
+                [a.r, a.g, a.b, 0.0]
+            },
         }
     }
 
@@ -348,7 +359,19 @@ impl SceneRenderer {
             background_rays: settings.background_rays.clamp(1, 8),
             flat_real_layer: self.real_plane.is_some(),
             point_lights: points > 0,
+            occlusion_gather: self.occluder(model).is_some(),
         }
+    }
+
+    /// The objects' occluding sphere now (centre, radius), when the lighting asks for the
+    /// occlusion gather.
+    fn occluder(&self, model: &SceneModel) -> Option<(Vec3, f32)> {
+        if !self.lighting.as_ref().is_some_and(|l| l.occlusion_gather) {
+            return None;
+        }
+        model
+            .objects_sphere()
+            .map(|(c, r)| (c, r * self.occluding_fraction))
     }
 
     /// Draws a frame of `model` and submits it.
@@ -397,10 +420,28 @@ impl SceneRenderer {
                 .lighting
                 .as_ref()
                 .map_or(&[][..], |l| &l.luminaires[..]);
+            let role = crate::point_lights::PointLightRole {
+                in_background: self
+                    .lighting
+                    .as_ref()
+                    .is_some_and(|l| l.luminaires_in_background),
+                light_objects: self
+                    .lighting
+                    .as_ref()
+                    .is_none_or(|l| l.luminaires_light_objects),
+            };
+            let points = crate::point_lights::PointLightInputs {
+                lights: luminaires,
+                map_scale: self.intensity.scale,
+                role,
+                near_field_m2: self
+                    .lighting
+                    .as_ref()
+                    .map_or(&[][..], |l| &l.luminaire_near_field_m2[..]),
+            };
             let (gpu_lights, region_moved) = self.shadows.fit(
                 lights,
-                luminaires,
-                self.intensity.scale,
+                &points,
                 model.description.lighting.shadows,
                 sphere,
                 model.geometry.real_bounds(),
@@ -500,4 +541,41 @@ fn clear_overlay(encoder: &mut wgpu::CommandEncoder, targets: &FrameTargets) {
         occlusion_query_set: None,
         multiview_mask: None,
     });
+}
+
+/// The radius of the sphere whose cross-section is the virtual objects' mean one, as a fraction
+/// of their bounding sphere's radius at load: by Cauchy's formula a convex body's shadow,
+/// averaged over all directions, is a quarter of its surface area `S`, so the sphere of radius
+/// `sqrt(S / (4 pi))` casts the same mean shadow (a concave body's is somewhat smaller).
+fn occluding_fraction(model: &SceneModel) -> f32 {
+    let Some((_, radius)) = model.objects_sphere() else {
+        return 0.0;
+    };
+    let area: f32 = model
+        .geometry
+        .objects
+        .iter()
+        .flat_map(|o| o.vertices.chunks_exact(3))
+        .map(|t| {
+            let [a, b, c] = [t[0], t[1], t[2]].map(|v| Vec3::from(v.position));
+            0.5 * (b - a).cross(c - a).length()
+        })
+        .sum();
+    ((area / (4.0 * std::f32::consts::PI)).sqrt() / radius).min(1.0)
+}
+
+/// The virtual objects' mean diffuse albedo over their materials (as edited).
+fn objects_albedo(model: &SceneModel) -> Rgb {
+    let materials = model.materials();
+    let slots: Vec<Rgb> = model
+        .geometry
+        .objects
+        .iter()
+        .flat_map(|o| o.materials.clone())
+        .map(|slot| materials[slot as usize].diffuse_albedo())
+        .collect();
+    if slots.is_empty() {
+        return Rgb::ZERO;
+    }
+    slots.iter().fold(Rgb::ZERO, |a, &b| a + b) / slots.len() as f32
 }

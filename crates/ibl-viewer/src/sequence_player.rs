@@ -251,6 +251,10 @@ impl SequencePlayer {
             return Ok(SceneLighting {
                 lights,
                 luminaires: Vec::new(),
+                luminaires_in_background: false,
+                luminaires_light_objects: true,
+                luminaire_near_field_m2: Vec::new(),
+                occlusion_gather: false,
                 ambient: None,
                 summary: format!(
                     "{sun} + the sky as {} shadowed median-cut lights, {sky} sky",
@@ -291,6 +295,10 @@ impl SequencePlayer {
         Ok(SceneLighting {
             lights,
             luminaires: Vec::new(),
+            luminaires_in_background: false,
+            luminaires_light_objects: true,
+            luminaire_near_field_m2: Vec::new(),
+            occlusion_gather: false,
             ambient: Some(ambient),
             summary: format!("{sun} + {source}, {sky} sky"),
         })

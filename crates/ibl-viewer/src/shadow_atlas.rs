@@ -31,7 +31,9 @@ use ibl_scene::ShadowKind;
 use crate::gpu::{DEPTH_FORMAT, GpuContext};
 use crate::gpu_scene::{GpuLight, GpuScene, vec4};
 use crate::light_space::{AtlasLayout, ShadowProjection, box_depths};
-use crate::point_lights::{FACES, FaceCasters, GpuPointLight, MAX_POINT_LIGHTS, gpu_point_lights};
+use crate::point_lights::{
+    FACES, FaceCasters, GpuPointLight, MAX_POINT_LIGHTS, PointLightInputs, gpu_point_lights,
+};
 use crate::scene_geometry::{VERTEX_ATTRIBUTES, Vertex};
 
 /// The real atlas covers this many times the virtual objects' bounding radius about them.
@@ -260,14 +262,12 @@ impl ShadowAtlases {
 
     /// The GPU lights: each light's tiles fitted to the scene (see the module notes). `objects`
     /// is the bounding sphere of the virtual objects now, `real_bounds` the real geometry's box.
-    /// The point lights' faces are fitted too (kept for drawing, [`Self::point_lights`]; their
-    /// strip of intensity maps has scale `map_scale`). Returns the directional lights and
+    /// The point lights' faces are fitted too (kept for drawing, [`Self::point_lights`]). Returns the directional lights and
     /// whether the real region moved (the real atlas must be redrawn).
     pub fn fit(
         &mut self,
         lights: &[DirectionalLight],
-        points: &[ibl_light::GoniometricLight],
-        map_scale: f32,
+        points: &PointLightInputs<'_>,
         shadows: ShadowKind,
         objects: (Vec3, f32),
         real_bounds: Option<(Vec3, Vec3)>,
@@ -276,13 +276,7 @@ impl ShadowAtlases {
             objects,
             real: real_bounds.map(|(lo, hi)| bounding_sphere(lo, hi)),
         };
-        self.points = gpu_point_lights(
-            points,
-            &self.real.layout,
-            lights.len() as u32,
-            casters,
-            map_scale,
-        );
+        self.points = gpu_point_lights(points, &self.real.layout, lights.len() as u32, casters);
         let (centre, radius) = objects;
         let region = match self.region {
             Some(r) if r.holds(centre, radius) => r,

@@ -63,6 +63,9 @@ pub struct ProbeExtras {
     /// An edits file (`ibl room render --edit`'s, docs/ROOMS.md) applied to the room: the
     /// edited panorama is shown instead of the probe (needs `room`).
     pub edit: Option<PathBuf>,
+    /// Draw the edits' objects live on the GPU, the room as the real layer (Grosch's display
+    /// the edits file names; `crate::room_live`), instead of showing the CPU's panorama.
+    pub live: bool,
 }
 
 impl ProbeExtras {
@@ -122,7 +125,9 @@ impl ProbeExtras {
                 "--edit applies an edits file to a room: give the room with --room".into(),
             ));
         }
-        if let Some(edit) = &self.edit {
+        if let Some(edit) = &self.edit
+            && !self.live
+        {
             crate::room_edit::read_panorama_edits(edit)?;
         }
         self.overlay().map(|_| ())
@@ -384,71 +389,96 @@ impl ViewJob {
         }
         let mut options = self.frames;
         let frames = u64::from(options.frames);
-        let (run, kind) = if is_scene(&self.input) {
-            let mut model = SceneModel::open(&self.input)?;
-            self.apply_scene_overrides(&mut model)?;
-            check_outputs(outputs.as_ref(), &model.inputs)?;
-            options.display = Some(self.display(headless::auto_exposure(&model))?);
-            let sequence = SequencePlayer::is_sequence(&model.description);
-            check_sky_lights(options.sky_lights, sequence)?;
-            if sequence {
-                options.motion = Motion::Sequence;
-                let centre = model.objects_sphere().map(|(c, _)| c);
-                progress.begin("sequence: offline maps and sample sites", 0);
-                let written: Vec<&Path> = outputs
-                    .iter()
-                    .flat_map(|(png, exr)| [png.as_path(), exr.as_path()])
-                    .collect();
-                let player = SequencePlayer::open(&self.input, centre, &written);
+        let (run, kind) =
+            if let (true, Some(room), Some(edit)) = (extras.live, &extras.room, &extras.edit) {
+                extras.check()?;
+                let mut inputs = extras.inputs();
+                inputs.push(self.input.clone());
+                check_outputs(outputs.as_ref(), &inputs)?;
+                progress.begin("room: estimate, edits, volume", 0);
+                let live = crate::room_live::room_live(room, edit, progress);
                 progress.end();
-                let mut player = player?;
+                let live = live?;
+                options.display = Some(self.display(headless::auto_exposure(&live.model))?);
                 let gpu = GpuContext::headless()?;
                 progress.begin("frames", frames);
-                let run =
-                    headless::render_sequence(&gpu, &model, &mut player, &options, &|d, t| {
+                let run = headless::render_scene_lit(
+                    &gpu,
+                    &live.model,
+                    live.lighting,
+                    0.0,
+                    &options,
+                    &|d, t| {
                         progress.update(d as u64, t as u64, None);
-                    });
-                progress.end();
-                (run?, ViewKind::Sequence)
-            } else {
-                let gpu = GpuContext::headless()?;
-                progress.begin("frames", frames);
-                let run = headless::render_scene(&gpu, &model, &options, &|d, t| {
-                    progress.update(d as u64, t as u64, None);
-                });
+                    },
+                );
                 progress.end();
                 (run?, ViewKind::Scene)
-            }
-        } else {
-            let mut model = ProbeModel::open(&self.input, self.mapping)?;
-            let mut inputs = extras.inputs();
-            inputs.push(self.input.clone());
-            check_outputs(outputs.as_ref(), &inputs)?;
-            let mut settings = self.probe_settings(&model)?;
-            extras.check()?;
-            extras.aim(&mut settings.orbit)?;
-            let room = extras.overlay()?;
-            if let (Some(room), Some(edit)) = (&extras.room, &extras.edit) {
-                progress.begin("room: estimate and edits", 0);
-                let edited = crate::room_edit::edited_panorama(room, edit, &model.latlong);
+            } else if is_scene(&self.input) {
+                let mut model = SceneModel::open(&self.input)?;
+                self.apply_scene_overrides(&mut model)?;
+                check_outputs(outputs.as_ref(), &model.inputs)?;
+                options.display = Some(self.display(headless::auto_exposure(&model))?);
+                let sequence = SequencePlayer::is_sequence(&model.description);
+                check_sky_lights(options.sky_lights, sequence)?;
+                if sequence {
+                    options.motion = Motion::Sequence;
+                    let centre = model.objects_sphere().map(|(c, _)| c);
+                    progress.begin("sequence: offline maps and sample sites", 0);
+                    let written: Vec<&Path> = outputs
+                        .iter()
+                        .flat_map(|(png, exr)| [png.as_path(), exr.as_path()])
+                        .collect();
+                    let player = SequencePlayer::open(&self.input, centre, &written);
+                    progress.end();
+                    let mut player = player?;
+                    let gpu = GpuContext::headless()?;
+                    progress.begin("frames", frames);
+                    let run =
+                        headless::render_sequence(&gpu, &model, &mut player, &options, &|d, t| {
+                            progress.update(d as u64, t as u64, None);
+                        });
+                    progress.end();
+                    (run?, ViewKind::Sequence)
+                } else {
+                    let gpu = GpuContext::headless()?;
+                    progress.begin("frames", frames);
+                    let run = headless::render_scene(&gpu, &model, &options, &|d, t| {
+                        progress.update(d as u64, t as u64, None);
+                    });
+                    progress.end();
+                    (run?, ViewKind::Scene)
+                }
+            } else {
+                let mut model = ProbeModel::open(&self.input, self.mapping)?;
+                let mut inputs = extras.inputs();
+                inputs.push(self.input.clone());
+                check_outputs(outputs.as_ref(), &inputs)?;
+                let mut settings = self.probe_settings(&model)?;
+                extras.check()?;
+                extras.aim(&mut settings.orbit)?;
+                let room = extras.overlay()?;
+                if let (Some(room), Some(edit)) = (&extras.room, &extras.edit) {
+                    progress.begin("room: estimate and edits", 0);
+                    let edited = crate::room_edit::edited_panorama(room, edit, &model.latlong);
+                    progress.end();
+                    model.latlong = std::sync::Arc::new(edited?);
+                }
+                let gpu = GpuContext::headless()?;
+                progress.begin("frames", frames);
+                let run = headless::render_probe_with(
+                    &gpu,
+                    &model,
+                    &settings,
+                    &options,
+                    room.as_ref(),
+                    &|d, t| {
+                        progress.update(d as u64, t as u64, None);
+                    },
+                );
                 progress.end();
-                model.latlong = std::sync::Arc::new(edited?);
-            }
-            let gpu = GpuContext::headless()?;
-            progress.begin("frames", frames);
-            let run = headless::render_probe_with(
-                &gpu,
-                &model,
-                &settings,
-                &options,
-                room.as_ref(),
-                &|d, t| {
-                    progress.update(d as u64, t as u64, None);
-                },
-            );
-            progress.end();
-            (run?, ViewKind::Probe)
-        };
+                (run?, ViewKind::Probe)
+            };
         let mut written = Vec::new();
         if let Some((png, exr)) = &outputs {
             write_frame(&run, png, exr)?;

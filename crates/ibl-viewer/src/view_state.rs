@@ -86,6 +86,13 @@ struct ObjectDrag {
     last_ray: (Vec3, Vec3),
 }
 
+impl SceneState {
+    /// The description of the lights drawn now (none before the first lighting arrives).
+    pub fn renderer_lighting_summary(&self) -> Option<String> {
+        self.renderer.lighting().map(|l| l.summary.clone())
+    }
+}
+
 /// The scene viewer's state.
 pub struct SceneState {
     /// The scene being edited.
@@ -117,6 +124,10 @@ pub struct SceneState {
     /// The outdoor sequence played (a scene with an `[outdoor]` table): its frames, sun and
     /// sky replace the background and the scene's `[lighting]`.
     pub sequence: Option<SequenceState>,
+    /// The lights were given with the scene (a room's live display, `crate::room_live`): the
+    /// scene's `[lighting]` does not replace them, and the scene is not saved (it is the room
+    /// and an edits file, not a scene file).
+    pub fixed_lighting: bool,
 }
 
 /// What the window has open.
@@ -156,6 +167,38 @@ impl Content {
                 "--marks, --room, --yaw, --pitch and --fov apply to a probe, not a scene".into(),
             ));
         }
+        if let (true, Some(room), Some(edit)) = (extras.live, &extras.room, &extras.edit) {
+            extras.check()?;
+            let live = crate::room_live::room_live(room, edit, &ibl_pipeline::progress::Silent)?;
+            let model = live.model;
+            let mut renderer = SceneRenderer::new(gpu, &model, size.0, size.1, shadow_tile)?;
+            renderer.set_lighting(gpu, live.lighting);
+            let display = Display {
+                exposure_stops: crate::headless::auto_exposure(&model),
+                ..Display::default()
+            };
+            return Ok(Content::Scene(Box::new(SceneState {
+                save_path: String::new(),
+                requested: Some(model.lighting_plan()),
+                model,
+                renderer,
+                worker: LatestWorker::new("ibl-view lights", |r: SceneLightingRequest| {
+                    scene_lighting(&r)
+                }),
+                camera: SceneCamera::File,
+                display,
+                glossy: GlossySource::Lights,
+                background_rays: 4,
+                shadow_tile,
+                selected: None,
+                drag: None,
+                lighting_seconds: 0.0,
+                last_camera: None,
+                hovered: None,
+                sequence: None,
+                fixed_lighting: true,
+            })));
+        }
         if is_scene {
             let model = SceneModel::open(path)?;
             let sequence = SequenceState::open(&model)?;
@@ -193,6 +236,7 @@ impl Content {
                 last_camera: None,
                 hovered: None,
                 sequence,
+                fixed_lighting: false,
             })))
         } else {
             let mut model = ProbeModel::open(path, mapping)?;
@@ -254,7 +298,7 @@ impl Content {
             Content::Scene(s) if s.sequence.is_some() => {
                 s.sequence.as_ref().is_some_and(SequenceState::busy)
             }
-            Content::Scene(s) => s.worker.busy() || s.requested.is_none(),
+            Content::Scene(s) => !s.fixed_lighting && (s.worker.busy() || s.requested.is_none()),
         }
     }
 
@@ -310,6 +354,7 @@ impl Content {
                     None => Ok(()),
                 }
             }
+            Content::Scene(s) if s.fixed_lighting => Ok(()),
             Content::Scene(s) => {
                 let plan = s.model.lighting_plan();
                 if s.requested.as_ref() != Some(&plan) {
