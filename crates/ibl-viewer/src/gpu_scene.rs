@@ -8,7 +8,6 @@ use ibl_scene::Material;
 use wgpu::util::DeviceExt;
 
 use crate::gpu::GpuContext;
-use crate::point_lights::GpuPointLight;
 use crate::scene_geometry::SceneGeometry;
 
 /// `Frame` of `gpu_scene.wgsl`.
@@ -64,6 +63,33 @@ pub struct GpuLight {
     pub virtual_tile: [f32; 4],
     /// Virtual tile extents.
     pub virtual_extent: [f32; 4],
+}
+
+/// Most point lights a frame draws (a scene's `[[luminaire]]` entries are bounded by
+/// `ibl_scene::description::MAX_LUMINAIRES`, the same number).
+pub const MAX_POINT_LIGHTS: usize = 64;
+
+/// Cube faces per point light (`point_lights.rs`).
+pub const FACES: usize = 6;
+
+/// One point light as the shaders read it (`gpu_scene.wgsl`'s `PointLight`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct GpuPointLight {
+    /// xyz: world position; w: the faces' near plane (world units).
+    pub position: [f32; 4],
+    /// x: the faces' far plane; y: a face tile's side, texels; z: 1 when the light is already
+    /// in the background (else a new light); w: 1 when it lights the virtual objects.
+    pub shadow: [f32; 4],
+    /// Rotation from world to the photometric frame (columns).
+    pub light_from_world: [[f32; 4]; 4],
+    /// Rows of its map in the strip (v0, dv, texture coordinates), the strip's scale and the
+    /// least squared distance counted (m^2, 0 for a point lamp).
+    pub map: [f32; 4],
+    /// Face tiles in the real atlas (u0, v0, du, dv), zero where the face sees no caster.
+    pub real_faces: [[f32; 4]; FACES],
+    /// Face tiles in the virtual atlas.
+    pub virtual_faces: [[f32; 4]; FACES],
 }
 
 /// `Object` of `gpu_scene.wgsl`.
@@ -238,9 +264,7 @@ impl GpuScene {
                 .device
                 .create_buffer_init(&wgpu::util::BufferInitDescriptor {
                     label: Some("point lights"),
-                    contents: bytemuck::cast_slice(
-                        &[GpuPointLight::zeroed(); crate::point_lights::MAX_POINT_LIGHTS],
-                    ),
+                    contents: bytemuck::cast_slice(&[GpuPointLight::zeroed(); MAX_POINT_LIGHTS]),
                     usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
                 }),
             frame: gpu.device.create_buffer(&wgpu::BufferDescriptor {
@@ -278,7 +302,7 @@ impl GpuScene {
 
     /// Writes the point lights (at most `MAX_POINT_LIGHTS`).
     pub fn write_point_lights(&self, gpu: &GpuContext, lights: &[GpuPointLight]) {
-        let lights = &lights[..lights.len().min(crate::point_lights::MAX_POINT_LIGHTS)];
+        let lights = &lights[..lights.len().min(MAX_POINT_LIGHTS)];
         if !lights.is_empty() {
             gpu.queue
                 .write_buffer(&self.point_lights, 0, bytemuck::cast_slice(lights));
@@ -313,7 +337,7 @@ mod tests {
         assert!(include_str!("gpu_scene.wgsl").contains(&declared));
         // 64 KiB: the uniform binding size every wgpu backend allows (WebGPU's default limit).
         assert!(std::mem::size_of::<GpuLight>() * MAX_SHADOWED_LIGHTS <= 1 << 16);
-        let points = crate::point_lights::MAX_POINT_LIGHTS;
+        let points = MAX_POINT_LIGHTS;
         let declared = format!("const MAX_POINT_LIGHTS: u32 = {points}u;");
         assert!(include_str!("gpu_scene.wgsl").contains(&declared));
         assert!(std::mem::size_of::<GpuPointLight>() * points <= 1 << 16);

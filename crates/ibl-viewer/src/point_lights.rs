@@ -22,46 +22,18 @@
 //!   Depth is the perspective projection's, between a near and a far plane fitted to the casters
 //!   ([`depth_range`]).
 
-use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use ibl_core::{Image, Rgb};
 use ibl_light::GoniometricLight;
 
-use crate::gpu_scene::{mat3_columns, vec4};
+use crate::gpu_scene::{FACES, GpuPointLight, MAX_POINT_LIGHTS, mat3_columns, vec4};
 use crate::light_space::AtlasLayout;
-
-/// Most point lights a frame draws (a scene's `[[luminaire]]` entries are bounded by
-/// `ibl_scene::description::MAX_LUMINAIRES`, the same number).
-pub const MAX_POINT_LIGHTS: usize = 64;
-
-/// Cube faces per light.
-pub const FACES: usize = 6;
 
 /// Columns of a light's intensity map (`C`, 360 degrees).
 pub const MAP_WIDTH: usize = 256;
 
 /// Rows of a light's intensity map (`gamma`, 180 degrees).
 pub const MAP_HEIGHT: usize = 128;
-
-/// One point light as the shaders read it (`gpu_scene.wgsl`'s `PointLight`).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
-pub struct GpuPointLight {
-    /// xyz: world position; w: the faces' near plane (world units).
-    pub position: [f32; 4],
-    /// x: the faces' far plane; y: a face tile's side, texels; z: 1 when the light is already
-    /// in the background (else a new light); w: 1 when it lights the virtual objects.
-    pub shadow: [f32; 4],
-    /// Rotation from world to the photometric frame (columns).
-    pub light_from_world: [[f32; 4]; 4],
-    /// Rows of its map in the strip (v0, dv, texture coordinates), the strip's scale and the
-    /// least squared distance counted (m^2, 0 for a point lamp).
-    pub map: [f32; 4],
-    /// Face tiles in the real atlas (u0, v0, du, dv), zero where the face sees no caster.
-    pub real_faces: [[f32; 4]; FACES],
-    /// Face tiles in the virtual atlas.
-    pub virtual_faces: [[f32; 4]; FACES],
-}
 
 /// The intensity maps of `lights` stacked into one strip (see the module notes), probe units
 /// per sr, `MAP_WIDTH x MAP_HEIGHT * lights.len()` (one black map when there are none).

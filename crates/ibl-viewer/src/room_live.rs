@@ -15,8 +15,8 @@ use ibl_pipeline::room_display::RoomDisplay;
 use ibl_room::DisplayMode;
 
 use crate::ViewerError;
+use crate::gpu_scene::MAX_POINT_LIGHTS;
 use crate::lighting::{IRRADIANCE_MAP_WIDTH, SceneLighting};
-use crate::point_lights::MAX_POINT_LIGHTS;
 use crate::scene_model::SceneModel;
 
 /// A room's live display: the scene to draw and its lights.

@@ -387,7 +387,7 @@ impl SceneRenderer {
             .lighting
             .as_ref()
             .map_or(&[][..], |l| &l.luminaires[..]);
-        let points = luminaires.len().min(crate::point_lights::MAX_POINT_LIGHTS) as u32;
+        let points = luminaires.len().min(crate::gpu_scene::MAX_POINT_LIGHTS) as u32;
         // Atlases sized for the lights and the requested tile.
         let tiles = ShadowAtlases::tiles_for(count as usize, points as usize);
         let wanted = crate::light_space::AtlasLayout::new(

@@ -29,11 +29,9 @@ use ibl_render::lighting::DirectionalLight;
 use ibl_scene::ShadowKind;
 
 use crate::gpu::{DEPTH_FORMAT, GpuContext};
-use crate::gpu_scene::{GpuLight, GpuScene, vec4};
+use crate::gpu_scene::{FACES, GpuLight, GpuPointLight, GpuScene, MAX_POINT_LIGHTS, vec4};
 use crate::light_space::{AtlasLayout, ShadowProjection, box_depths};
-use crate::point_lights::{
-    FACES, FaceCasters, GpuPointLight, MAX_POINT_LIGHTS, PointLightInputs, gpu_point_lights,
-};
+use crate::point_lights::{FaceCasters, PointLightInputs, gpu_point_lights};
 use crate::scene_geometry::{VERTEX_ATTRIBUTES, Vertex};
 
 /// The real atlas covers this many times the virtual objects' bounding radius about them.
