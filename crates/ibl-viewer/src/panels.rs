@@ -205,19 +205,12 @@ fn scene_panel(ui: &mut egui::Ui, s: &mut SceneState, gpu_changed: &mut bool) {
     ui.heading("Scene");
     ui.label(s.model.path.display().to_string());
     ui.separator();
-    if let Some(sequence) = &mut s.sequence {
-        sequence_section(ui, sequence);
-        ui.separator();
-        ui.label("Display");
-        let automatic = crate::headless::auto_exposure(&s.model);
-        display_controls(ui, &mut s.display, automatic);
-        ui.separator();
-        object_panel(ui, s, gpu_changed);
-        return;
-    }
-    if s.fixed_lighting {
-        // A room's live display: its lights are the room's (crate::room_live).
-        if let Some(l) = s.renderer_lighting_summary() {
+    // An outdoor sequence's lights come from its frames, a room's live display's from the
+    // room (crate::room_live): neither has a [lighting] to edit.
+    if s.sequence.is_some() || s.fixed_lighting {
+        if let Some(sequence) = &mut s.sequence {
+            sequence_section(ui, sequence);
+        } else if let Some(l) = s.renderer_lighting_summary() {
             ui.label(l);
         }
         ui.separator();

@@ -87,6 +87,41 @@ struct ObjectDrag {
 }
 
 impl SceneState {
+    /// A scene's state as opened: its lights still to be made by the worker, nothing selected,
+    /// the automatic exposure, no save path and no sequence.
+    fn new(
+        model: SceneModel,
+        renderer: SceneRenderer,
+        camera: SceneCamera,
+        shadow_tile: u32,
+    ) -> SceneState {
+        let display = Display {
+            exposure_stops: crate::headless::auto_exposure(&model),
+            ..Display::default()
+        };
+        SceneState {
+            save_path: String::new(),
+            model,
+            renderer,
+            worker: LatestWorker::new("ibl-view lights", |r: SceneLightingRequest| {
+                scene_lighting(&r)
+            }),
+            requested: None,
+            camera,
+            display,
+            glossy: GlossySource::Lights,
+            background_rays: 4,
+            shadow_tile,
+            selected: None,
+            drag: None,
+            lighting_seconds: 0.0,
+            last_camera: None,
+            hovered: None,
+            sequence: None,
+            fixed_lighting: false,
+        }
+    }
+
     /// The description of the lights drawn now (none before the first lighting arrives).
     pub fn renderer_lighting_summary(&self) -> Option<String> {
         self.renderer.lighting().map(|l| l.summary.clone())
@@ -170,43 +205,17 @@ impl Content {
         if let (true, Some(room), Some(edit)) = (extras.live, &extras.room, &extras.edit) {
             extras.check()?;
             let live = crate::room_live::room_live(room, edit, &ibl_pipeline::progress::Silent)?;
-            let model = live.model;
-            let mut renderer = SceneRenderer::new(gpu, &model, size.0, size.1, shadow_tile)?;
+            let mut renderer = SceneRenderer::new(gpu, &live.model, size.0, size.1, shadow_tile)?;
             renderer.set_lighting(gpu, live.lighting);
-            let display = Display {
-                exposure_stops: crate::headless::auto_exposure(&model),
-                ..Display::default()
-            };
-            return Ok(Content::Scene(Box::new(SceneState {
-                save_path: String::new(),
-                requested: Some(model.lighting_plan()),
-                model,
-                renderer,
-                worker: LatestWorker::new("ibl-view lights", |r: SceneLightingRequest| {
-                    scene_lighting(&r)
-                }),
-                camera: SceneCamera::File,
-                display,
-                glossy: GlossySource::Lights,
-                background_rays: 4,
-                shadow_tile,
-                selected: None,
-                drag: None,
-                lighting_seconds: 0.0,
-                last_camera: None,
-                hovered: None,
-                sequence: None,
-                fixed_lighting: true,
-            })));
+            let mut state = SceneState::new(live.model, renderer, SceneCamera::File, shadow_tile);
+            state.requested = Some(state.model.lighting_plan());
+            state.fixed_lighting = true;
+            return Ok(Content::Scene(Box::new(state)));
         }
         if is_scene {
             let model = SceneModel::open(path)?;
             let sequence = SequenceState::open(&model)?;
             let renderer = SceneRenderer::new(gpu, &model, size.0, size.1, shadow_tile)?;
-            let display = Display {
-                exposure_stops: crate::headless::auto_exposure(&model),
-                ..Display::default()
-            };
             let camera = match model.scene.camera {
                 ibl_scene::Camera::Pinhole { .. } => SceneCamera::File,
                 ibl_scene::Camera::Panorama { position, .. } => SceneCamera::Orbit(OrbitControl {
@@ -217,27 +226,10 @@ impl Content {
                     vertical_fov: 60f32.to_radians(),
                 }),
             };
-            Ok(Content::Scene(Box::new(SceneState {
-                save_path: default_save_path(path).display().to_string(),
-                model,
-                renderer,
-                worker: LatestWorker::new("ibl-view lights", |r: SceneLightingRequest| {
-                    scene_lighting(&r)
-                }),
-                requested: None,
-                camera,
-                display,
-                glossy: GlossySource::Lights,
-                background_rays: 4,
-                shadow_tile,
-                selected: None,
-                drag: None,
-                lighting_seconds: 0.0,
-                last_camera: None,
-                hovered: None,
-                sequence,
-                fixed_lighting: false,
-            })))
+            let mut state = SceneState::new(model, renderer, camera, shadow_tile);
+            state.save_path = default_save_path(path).display().to_string();
+            state.sequence = sequence;
+            Ok(Content::Scene(Box::new(state)))
         } else {
             let mut model = ProbeModel::open(path, mapping)?;
             let mut settings = ProbeViewSettings::for_probe(&model.latlong);

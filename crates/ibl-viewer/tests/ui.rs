@@ -448,3 +448,62 @@ fn a_click_places_a_light_and_its_pool_brightens_the_floor() {
             .is_some_and(|e| e.lights.is_empty())
     });
 }
+
+#[test]
+fn the_live_room_display_redraws_the_bunny_where_it_is_moved() {
+    // `--live` (docs/ROOMS.md section 14): the edits' bunny drawn by the GPU in the room, its
+    // lights the room's 32 important patches. Moving it redraws it (and its shadows) at once.
+    let Some(gpu) = common::gpu_or_skip("ui live") else {
+        return;
+    };
+    let apartment = common::assets().join("rooms/apartment");
+    let extras = ProbeExtras {
+        room: Some(apartment.join("room.toml")),
+        edit: Some(apartment.join("edits-object.toml")),
+        live: true,
+        ..ProbeExtras::default()
+    };
+    let mut h = harness_with(
+        &gpu,
+        Some(common::assets().join("probes/apartment.exr")),
+        extras,
+        520.0,
+    );
+    h.step();
+    assert!(h.state().error.is_none(), "{:?}", h.state().error);
+    let summary = match &h.state().content {
+        Content::Scene(s) => s
+            .lighting()
+            .map(|l| (l.summary.clone(), l.luminaires.len())),
+        _ => panic!("the live display is a scene"),
+    };
+    let (summary, points) = summary.expect("the room's lights are given at once");
+    assert!(summary.contains("improved display"), "{summary}");
+    assert_eq!(points, 32, "the 32 important patches");
+    let frame = |h: &mut Harness<'static, ViewerApp>| {
+        h.step();
+        match &h.state().content {
+            Content::Scene(s) => s.read_frame(&gpu).expect("reads the frame back").display,
+            _ => panic!("a scene is open"),
+        }
+    };
+    let before = frame(&mut h);
+    match &mut h.state_mut().content {
+        Content::Scene(s) => s.model.translate(0, glam::Vec3::new(-0.3, 0.0, 0.2)),
+        _ => panic!("a scene is open"),
+    }
+    let after = frame(&mut h);
+    let changed = before
+        .pixels()
+        .iter()
+        .zip(after.pixels())
+        .filter(|(a, b)| a != b)
+        .count();
+    // The bunny covers about 4 % of the view; moved by 0.36 m it leaves its old place and
+    // takes a new one, and its shadows go with it.
+    assert!(
+        changed > before.len() / 50,
+        "only {changed} of {} pixels changed",
+        before.len()
+    );
+}
