@@ -12,7 +12,7 @@ use ibl_pipeline::demo_section::{DemoSection, PageSection};
 
 use crate::headless::{HeadlessOptions, Motion};
 use crate::probe_model::Overlays;
-use crate::view_job::{ProbeViewOptions, ViewJob, ViewSummary};
+use crate::view_job::{ProbeExtras, ProbeViewOptions, ViewJob, ViewSummary};
 
 /// Folder of the frames inside the demo's output folder.
 pub const VIEWER_DIR: &str = "viewer";
@@ -103,7 +103,11 @@ impl DemoSection for ViewerFrames {
              <code>ibl view SCENE --headless</code> (the same code as the window), its lights \
              each with a shadow map, composited into the probe on the GPU; and the outdoor \
              sequence played by the viewer (its third frame: each frame's sun and sky \
-             estimated as <code>ibl outdoor</code> does, the sun with its shadow).</p>",
+             estimated as <code>ibl outdoor</code> does, the sun with its shadow); the scene \
+             with an IES luminaire; and the worked example room's bunny drawn live in the \
+             reconstructed room (<code>ibl view PROBE --room ROOM --edit EDITS --live</code>: \
+             Grosch's improved display, the 32 important patches as shadowed point \
+             lights).</p>",
         );
         let mut data = Vec::new();
         // The scenes the demo rendered, so the two sections show the same ones.
@@ -126,14 +130,37 @@ impl DemoSection for ViewerFrames {
         };
         let mut named: Vec<(String, PathBuf)> =
             files.iter().map(|p| (stem(p), p.clone())).collect();
+        // The scene with a luminaire (a point light with its cube shadow map).
+        let lamp = scenes.join("lamp/bunny-lamp.toml");
+        if lamp.is_file() {
+            named.push(("bunny-lamp".into(), lamp));
+        }
         // The sequence is named after its folder (its file is `scene.toml`).
         if let Some(o) = outdoor {
             let folder = o.parent().map_or_else(|| stem(o), stem);
             named.push((format!("outdoor-{folder}"), o.to_path_buf()));
         }
-        for (name, scene) in &named {
+        // The room's live display (docs/ROOMS.md section 14): the bunny of the worked example's
+        // edits file in the reconstructed room, Grosch's improved display on the GPU.
+        let assets = scenes.parent().unwrap_or(scenes);
+        let apartment = assets.join("rooms/apartment");
+        let live = ProbeExtras {
+            room: Some(apartment.join("room.toml")),
+            edit: Some(apartment.join("edits-object.toml")),
+            live: true,
+            ..ProbeExtras::default()
+        };
+        let probe = assets.join("probes/apartment.exr");
+        let mut jobs: Vec<(String, PathBuf, ProbeExtras)> = named
+            .into_iter()
+            .map(|(name, scene)| (name, scene, ProbeExtras::default()))
+            .collect();
+        if probe.is_file() && live.inputs().iter().all(|p| p.is_file()) {
+            jobs.push(("room-live-improved".into(), probe, live));
+        }
+        for (name, scene, extras) in &jobs {
             let png = format!("{VIEWER_DIR}/{name}.png");
-            match job(scene, out.join(&png)).run(progress) {
+            match job(scene, out.join(&png)).run_with(extras, progress) {
                 Ok(summary) => {
                     let _ = write!(
                         html,
