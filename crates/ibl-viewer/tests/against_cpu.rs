@@ -51,8 +51,12 @@ fn gpu_frame(gpu: &ibl_viewer::gpu::GpuContext, model: &SceneModel) -> headless:
 /// Compares the viewer with the CPU on the scene at `path` (asserting the thresholds)
 /// and returns both composites, GPU first; `None` when no GPU adapter exists.
 fn compare_file(name: &str, path: &std::path::Path) -> Option<(Image<Rgb>, Image<Rgb>)> {
+    compare_model(name, lights_mode(path))
+}
+
+/// [`compare_file`] for a scene already opened (and changed).
+fn compare_model(name: &str, model: SceneModel) -> Option<(Image<Rgb>, Image<Rgb>)> {
     let gpu = common::gpu_or_skip(name)?;
-    let model = lights_mode(path);
     let started = std::time::Instant::now();
     let gpu_run = gpu_frame(&gpu, &model);
     let gpu_seconds = started.elapsed().as_secs_f64();
@@ -158,4 +162,15 @@ fn the_lamp_scene_matches_the_cpu_lights_mode() {
         (with - cpu).abs() <= 0.01 * cpu,
         "GPU {with} against CPU {cpu}"
     );
+}
+
+#[test]
+fn the_lamp_scene_matches_the_cpu_under_the_difference_rule_too() {
+    // bunny-lamp composites by the ratio rule; under the difference rule a new light's pool is
+    // added to the background as `rho / pi E` of the ground's albedo instead.
+    let mut model = lights_mode(&common::assets().join("scenes/lamp/bunny-lamp.toml"));
+    model.description.render.composite = ibl_scene::description::CompositeRule::Difference;
+    std::sync::Arc::make_mut(&mut model.scene).render.composite =
+        ibl_scene::description::CompositeRule::Difference;
+    let _ = compare_model("bunny-lamp-difference", model);
 }
