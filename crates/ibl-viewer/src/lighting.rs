@@ -27,6 +27,8 @@ use ibl_render::lighting::DirectionalLight;
 use ibl_scene::Scene;
 use ibl_sh::IrradianceSh;
 
+use crate::point_lights::{PointLightInputs, PointLightRole};
+
 /// Width of the irradiance maps (height is half).
 pub const IRRADIANCE_MAP_WIDTH: usize = 128;
 
@@ -38,13 +40,8 @@ pub struct SceneLighting {
     /// The goniometric point lights (a scene's `[[luminaire]]` entries: the CPU renderer's
     /// `Lighting::luminaires`, `point_lights.rs`).
     pub luminaires: Vec<ibl_light::GoniometricLight>,
-    /// Whether the luminaires' light is already in the background (a room's important patches
-    /// and placed lights): then on real surfaces they only cast the objects' shadows; else they
-    /// are new lights, whose whole light joins the background.
-    pub luminaires_in_background: bool,
-    /// Whether the luminaires light the virtual objects (not in Grosch's fast display, whose
-    /// objects take all their light from the irradiance volume).
-    pub luminaires_light_objects: bool,
+    /// How the luminaires take part in the composite.
+    pub luminaire_role: PointLightRole,
     /// Per luminaire, the least squared distance its `1 / d^2` counts, m^2 (a room's patch as a
     /// point: its area, as `ibl_room::ObjectDisplay` bounds a patch's near field); missing
     /// entries are 0 (a point lamp).
@@ -57,6 +54,19 @@ pub struct SceneLighting {
     pub ambient: Option<Image<Rgb>>,
     /// A short description: `16 median-cut lights`, `8 lightgen lights + SH9 ambient`.
     pub summary: String,
+}
+
+impl SceneLighting {
+    /// The luminaires as the shadow atlases fit them, their strip of intensity maps at scale
+    /// `map_scale`.
+    pub fn point_light_inputs(&self, map_scale: f32) -> PointLightInputs<'_> {
+        PointLightInputs {
+            lights: &self.luminaires,
+            map_scale,
+            role: self.luminaire_role,
+            near_field_m2: &self.luminaire_near_field_m2,
+        }
+    }
 }
 
 /// A request for a scene's lighting.
@@ -108,8 +118,7 @@ pub fn scene_lighting(request: &SceneLightingRequest) -> Result<SceneLighting, S
     Ok(SceneLighting {
         lights: list.lights.clone(),
         luminaires: lighting.luminaires.clone(),
-        luminaires_in_background: false,
-        luminaires_light_objects: true,
+        luminaire_role: PointLightRole::NEW,
         luminaire_near_field_m2: Vec::new(),
         occlusion_gather: false,
         ambient: ambient

@@ -84,10 +84,21 @@ pub fn depth_range(light: Vec3, centre: Vec3, radius: f32) -> (f32, f32) {
 /// How a frame's point lights take part in the composite.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PointLightRole {
-    /// Their light is already in the background (see `SceneLighting::luminaires_in_background`).
+    /// Their light is already in the background (a room's important patches and placed
+    /// lights): then on real surfaces they only cast the objects' shadows; else they are new
+    /// lights, whose whole light joins the background.
     pub in_background: bool,
-    /// They light the virtual objects.
+    /// They light the virtual objects (not in Grosch's fast display, whose objects take all
+    /// their light from the irradiance volume).
     pub light_objects: bool,
+}
+
+impl PointLightRole {
+    /// A scene's `[[luminaire]]` entries: new lights that light everything.
+    pub const NEW: PointLightRole = PointLightRole {
+        in_background: false,
+        light_objects: true,
+    };
 }
 
 /// A frame's point lights as the atlases fit them.
@@ -101,6 +112,16 @@ pub struct PointLightInputs<'a> {
     pub role: PointLightRole,
     /// Per light, the least squared distance counted, m^2 (missing: 0).
     pub near_field_m2: &'a [f32],
+}
+
+impl PointLightInputs<'static> {
+    /// No point lights.
+    pub const NONE: PointLightInputs<'static> = PointLightInputs {
+        lights: &[],
+        map_scale: 1.0,
+        role: PointLightRole::NEW,
+        near_field_m2: &[],
+    };
 }
 
 /// What the faces of a frame's point lights are fitted to.

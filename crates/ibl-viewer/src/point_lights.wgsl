@@ -83,6 +83,30 @@ fn point_light_term(k: u32, fc: vec3<f32>, wi: vec3<f32>, d2: f32) -> vec3<f32> 
     return fc * point_intensity(k, -wi) / max(d2, point_lights[k].map.w);
 }
 
+// Point light k seen from a surface point p: its position, the unit direction wi to it, the
+// squared distance d2 and the BSDF term fc = f cos(theta_i) along wi (zero when the light is
+// behind the surface or at the point itself).
+struct PointArrival {
+    light: vec3<f32>,
+    wi: vec3<f32>,
+    d2: f32,
+    fc: vec3<f32>,
+};
+
+fn point_arrival(k: u32, m: Material, p: vec3<f32>, f: SurfaceFrame, wo: vec3<f32>) -> PointArrival {
+    var a: PointArrival;
+    a.light = point_lights[k].position.xyz;
+    let to_light = a.light - p;
+    a.d2 = dot(to_light, to_light);
+    a.fc = vec3<f32>(0.0);
+    if a.d2 > 0.0 {
+        a.wi = to_light * inverseSqrt(a.d2);
+        // A point light lights glossy lobes too: the probe's reflection does not hold it.
+        a.fc = reflection(m, f.ns, f.ng, wo, a.wi, true);
+    }
+    return a;
+}
+
 // Adds the point lights to a surface's sums. A new light (Grosch 2005 section 4.2: the scene
 // without the objects, which the background shows, has none of its light) gives a real
 // surface its whole light as a change; a light already in the background (a room's important
@@ -97,29 +121,21 @@ fn add_point_lights(m: Material, p: vec3<f32>, f: SurfaceFrame, wo: vec3<f32>, o
         if on_virtual && point_lights[k].shadow.w < 0.5 {
             continue;
         }
-        let light = point_lights[k].position.xyz;
-        let to_light = light - p;
-        let d2 = dot(to_light, to_light);
-        if d2 <= 0.0 {
+        let a = point_arrival(k, m, p, f, wo);
+        if all(a.fc <= vec3<f32>(0.0)) {
             continue;
         }
-        let wi = to_light * inverseSqrt(d2);
-        // A new light lights glossy lobes too: the probe's reflection does not hold it.
-        let fc = reflection(m, f.ns, f.ng, wo, wi, true);
-        if all(fc <= vec3<f32>(0.0)) {
-            continue;
-        }
-        let cos_light = dot(f.ng, wi);
-        let vv = point_atlas_visibility(virtual_atlas, frame.atlas.zw, k, false, light, p, f.ng, cos_light);
+        let cos_light = dot(f.ng, a.wi);
+        let vv = point_atlas_visibility(virtual_atlas, frame.atlas.zw, k, false, a.light, p, f.ng, cos_light);
         if !on_virtual && in_background && vv >= 1.0 {
             // Not shadowed by the objects: with and without agree.
             continue;
         }
-        let e = point_light_term(k, fc, wi, d2);
+        let e = point_light_term(k, a.fc, a.wi, a.d2);
         if all(e <= vec3<f32>(0.0)) {
             continue;
         }
-        let lit = e * point_real_visibility(k, light, p, f.ng, cos_light);
+        let lit = e * point_real_visibility(k, a.light, p, f.ng, cos_light);
         if on_virtual {
             sums.direct = sums.direct + lit * vv;
         } else if in_background {
@@ -142,19 +158,12 @@ fn point_lights_without(m: Material, p: vec3<f32>, f: SurfaceFrame, wo: vec3<f32
         if point_lights[k].shadow.z < 0.5 {
             continue;
         }
-        let light = point_lights[k].position.xyz;
-        let to_light = light - p;
-        let d2 = dot(to_light, to_light);
-        if d2 <= 0.0 {
+        let a = point_arrival(k, m, p, f, wo);
+        if all(a.fc <= vec3<f32>(0.0)) {
             continue;
         }
-        let wi = to_light * inverseSqrt(d2);
-        let fc = reflection(m, f.ns, f.ng, wo, wi, true);
-        if all(fc <= vec3<f32>(0.0)) {
-            continue;
-        }
-        without = without + point_light_term(k, fc, wi, d2)
-            * point_real_visibility(k, light, p, f.ng, dot(f.ng, wi));
+        without = without + point_light_term(k, a.fc, a.wi, a.d2)
+            * point_real_visibility(k, a.light, p, f.ng, dot(f.ng, a.wi));
     }
     return without;
 }

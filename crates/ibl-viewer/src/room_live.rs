@@ -17,6 +17,7 @@ use ibl_room::DisplayMode;
 use crate::ViewerError;
 use crate::gpu_scene::MAX_POINT_LIGHTS;
 use crate::lighting::{IRRADIANCE_MAP_WIDTH, SceneLighting};
+use crate::point_lights::PointLightRole;
 use crate::scene_model::SceneModel;
 
 /// A room's live display: the scene to draw and its lights.
@@ -73,8 +74,10 @@ pub fn room_live(
     let lighting = SceneLighting {
         lights: Vec::new(),
         luminaires: lights,
-        luminaires_in_background: true,
-        luminaires_light_objects: display.lights_objects(),
+        luminaire_role: PointLightRole {
+            in_background: true,
+            light_objects: display.lights_objects(),
+        },
         luminaire_near_field_m2: display.near_field_m2(),
         occlusion_gather: display.lights_objects(),
         ambient: Some(ambient),

@@ -300,6 +300,7 @@ impl SceneRenderer {
         settings: &SceneFrameSettings,
         lights: u32,
         points: u32,
+        occluder: Option<(Vec3, f32)>,
     ) -> FrameUniform {
         let c = &settings.camera;
         let (w, h) = self.targets.size;
@@ -331,12 +332,13 @@ impl SceneRenderer {
             real_plane: self
                 .real_plane
                 .map_or([0.0; 4], |(n, d)| [n.x, n.y, n.z, d]),
-            occluder: self
-                .occluder(model)
-                .map_or([0.0; 4], |(c, r)| [c.x, c.y, c.z, r]),
-            occluder_albedo: {
-                let a = objects_albedo(model);
-                [a.r, a.g, a.b, 0.0]
+            occluder: occluder.map_or([0.0; 4], |(c, r)| [c.x, c.y, c.z, r]),
+            occluder_albedo: match occluder {
+                Some(_) => {
+                    let a = objects_albedo(model);
+                    [a.r, a.g, a.b, 0.0]
+                }
+                None => [0.0; 4],
             },
         }
     }
@@ -348,6 +350,7 @@ impl SceneRenderer {
         settings: &SceneFrameSettings,
         lights: u32,
         points: u32,
+        occlusion_gather: bool,
     ) -> ShaderVariant {
         ShaderVariant {
             tiled_lights: lights >= crate::light_tiles::MIN_TILED_LIGHTS,
@@ -359,7 +362,7 @@ impl SceneRenderer {
             background_rays: settings.background_rays.clamp(1, 8),
             flat_real_layer: self.real_plane.is_some(),
             point_lights: points > 0,
-            occlusion_gather: self.occluder(model).is_some(),
+            occlusion_gather,
         }
     }
 
@@ -383,11 +386,9 @@ impl SceneRenderer {
     ) -> FrameReport {
         let started = std::time::Instant::now();
         let count = self.lighting.as_ref().map_or(0, |l| l.lights.len()) as u32;
-        let luminaires = self
-            .lighting
-            .as_ref()
-            .map_or(&[][..], |l| &l.luminaires[..]);
-        let points = luminaires.len().min(crate::gpu_scene::MAX_POINT_LIGHTS) as u32;
+        let points = self.lighting.as_ref().map_or(0, |l| {
+            l.luminaires.len().min(crate::gpu_scene::MAX_POINT_LIGHTS)
+        }) as u32;
         // Atlases sized for the lights and the requested tile.
         let tiles = ShadowAtlases::tiles_for(count as usize, points as usize);
         let wanted = crate::light_space::AtlasLayout::new(
@@ -416,29 +417,12 @@ impl SceneRenderer {
         let mut draw_real = self.lights_changed;
         if moved || self.lights_changed {
             let lights = self.lighting.as_ref().map_or(&[][..], |l| &l.lights[..]);
-            let luminaires = self
+            let points = self
                 .lighting
                 .as_ref()
-                .map_or(&[][..], |l| &l.luminaires[..]);
-            let role = crate::point_lights::PointLightRole {
-                in_background: self
-                    .lighting
-                    .as_ref()
-                    .is_some_and(|l| l.luminaires_in_background),
-                light_objects: self
-                    .lighting
-                    .as_ref()
-                    .is_none_or(|l| l.luminaires_light_objects),
-            };
-            let points = crate::point_lights::PointLightInputs {
-                lights: luminaires,
-                map_scale: self.intensity.scale,
-                role,
-                near_field_m2: self
-                    .lighting
-                    .as_ref()
-                    .map_or(&[][..], |l| &l.luminaire_near_field_m2[..]),
-            };
+                .map_or(crate::point_lights::PointLightInputs::NONE, |l| {
+                    l.point_light_inputs(self.intensity.scale)
+                });
             let (gpu_lights, region_moved) = self.shadows.fit(
                 lights,
                 &points,
@@ -460,9 +444,10 @@ impl SceneRenderer {
                 .map(|(i, &m)| GpuObject::new(m, true, settings.selected == Some(i))),
         );
         self.gpu_scene.write_transforms(gpu, &objects);
-        let uniform = self.frame_uniform(model, settings, count, points);
+        let occluder = self.occluder(model);
+        let uniform = self.frame_uniform(model, settings, count, points, occluder);
         self.gpu_scene.write_frame(gpu, &uniform);
-        let variant = self.shader_variant(model, settings, count, points);
+        let variant = self.shader_variant(model, settings, count, points, occluder.is_some());
         self.scene_pass.prepare(gpu, variant);
 
         let mut encoder = gpu

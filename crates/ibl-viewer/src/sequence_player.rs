@@ -46,6 +46,7 @@ use serde::Serialize;
 use crate::ViewerError;
 use crate::gpu::GpuContext;
 use crate::lighting::{IRRADIANCE_MAP_WIDTH, SceneLighting, irradiance_map};
+use crate::point_lights::PointLightRole;
 use crate::scene_model::SceneModel;
 use crate::scene_renderer::SceneRenderer;
 
@@ -251,8 +252,7 @@ impl SequencePlayer {
             return Ok(SceneLighting {
                 lights,
                 luminaires: Vec::new(),
-                luminaires_in_background: false,
-                luminaires_light_objects: true,
+                luminaire_role: PointLightRole::NEW,
                 luminaire_near_field_m2: Vec::new(),
                 occlusion_gather: false,
                 ambient: None,
@@ -295,8 +295,7 @@ impl SequencePlayer {
         Ok(SceneLighting {
             lights,
             luminaires: Vec::new(),
-            luminaires_in_background: false,
-            luminaires_light_objects: true,
+            luminaire_role: PointLightRole::NEW,
             luminaire_near_field_m2: Vec::new(),
             occlusion_gather: false,
             ambient: Some(ambient),

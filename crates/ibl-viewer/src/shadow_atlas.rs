@@ -260,8 +260,9 @@ impl ShadowAtlases {
 
     /// The GPU lights: each light's tiles fitted to the scene (see the module notes). `objects`
     /// is the bounding sphere of the virtual objects now, `real_bounds` the real geometry's box.
-    /// The point lights' faces are fitted too (kept for drawing, [`Self::point_lights`]). Returns the directional lights and
-    /// whether the real region moved (the real atlas must be redrawn).
+    /// The point lights' faces are fitted too (kept for drawing, [`Self::point_lights`]).
+    /// Returns the directional lights and whether the real region moved (the real atlas must
+    /// be redrawn).
     pub fn fit(
         &mut self,
         lights: &[DirectionalLight],

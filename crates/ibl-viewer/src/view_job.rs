@@ -84,6 +84,14 @@ impl ProbeExtras {
             .collect()
     }
 
+    /// The room and edits file of a live display (`live` with both given), else `None`.
+    pub fn live_room(&self) -> Option<(&Path, &Path)> {
+        match (self.live, &self.room, &self.edit) {
+            (true, Some(room), Some(edit)) => Some((room, edit)),
+            _ => None,
+        }
+    }
+
     /// Turns `orbit` as asked (angles checked).
     pub fn aim(&self, orbit: &mut OrbitControl) -> Result<(), ViewerError> {
         let bad = |what: &str, v: f32, range: &str| {
@@ -389,96 +397,74 @@ impl ViewJob {
         }
         let mut options = self.frames;
         let frames = u64::from(options.frames);
-        let (run, kind) =
-            if let (true, Some(room), Some(edit)) = (extras.live, &extras.room, &extras.edit) {
-                extras.check()?;
-                let mut inputs = extras.inputs();
-                inputs.push(self.input.clone());
-                check_outputs(outputs.as_ref(), &inputs)?;
-                progress.begin("room: estimate, edits, volume", 0);
-                let live = crate::room_live::room_live(room, edit, progress);
+        let (run, kind) = if let Some((room, edit)) = extras.live_room() {
+            let run = self.run_live(room, edit, extras, outputs.as_ref(), &mut options, progress);
+            (run?, ViewKind::Scene)
+        } else if is_scene(&self.input) {
+            let mut model = SceneModel::open(&self.input)?;
+            self.apply_scene_overrides(&mut model)?;
+            check_outputs(outputs.as_ref(), &model.inputs)?;
+            options.display = Some(self.display(headless::auto_exposure(&model))?);
+            let sequence = SequencePlayer::is_sequence(&model.description);
+            check_sky_lights(options.sky_lights, sequence)?;
+            if sequence {
+                options.motion = Motion::Sequence;
+                let centre = model.objects_sphere().map(|(c, _)| c);
+                progress.begin("sequence: offline maps and sample sites", 0);
+                let written: Vec<&Path> = outputs
+                    .iter()
+                    .flat_map(|(png, exr)| [png.as_path(), exr.as_path()])
+                    .collect();
+                let player = SequencePlayer::open(&self.input, centre, &written);
                 progress.end();
-                let live = live?;
-                options.display = Some(self.display(headless::auto_exposure(&live.model))?);
+                let mut player = player?;
                 let gpu = GpuContext::headless()?;
                 progress.begin("frames", frames);
-                let run = headless::render_scene_lit(
-                    &gpu,
-                    &live.model,
-                    live.lighting,
-                    0.0,
-                    &options,
-                    &|d, t| {
-                        progress.update(d as u64, t as u64, None);
-                    },
-                );
-                progress.end();
-                (run?, ViewKind::Scene)
-            } else if is_scene(&self.input) {
-                let mut model = SceneModel::open(&self.input)?;
-                self.apply_scene_overrides(&mut model)?;
-                check_outputs(outputs.as_ref(), &model.inputs)?;
-                options.display = Some(self.display(headless::auto_exposure(&model))?);
-                let sequence = SequencePlayer::is_sequence(&model.description);
-                check_sky_lights(options.sky_lights, sequence)?;
-                if sequence {
-                    options.motion = Motion::Sequence;
-                    let centre = model.objects_sphere().map(|(c, _)| c);
-                    progress.begin("sequence: offline maps and sample sites", 0);
-                    let written: Vec<&Path> = outputs
-                        .iter()
-                        .flat_map(|(png, exr)| [png.as_path(), exr.as_path()])
-                        .collect();
-                    let player = SequencePlayer::open(&self.input, centre, &written);
-                    progress.end();
-                    let mut player = player?;
-                    let gpu = GpuContext::headless()?;
-                    progress.begin("frames", frames);
-                    let run =
-                        headless::render_sequence(&gpu, &model, &mut player, &options, &|d, t| {
-                            progress.update(d as u64, t as u64, None);
-                        });
-                    progress.end();
-                    (run?, ViewKind::Sequence)
-                } else {
-                    let gpu = GpuContext::headless()?;
-                    progress.begin("frames", frames);
-                    let run = headless::render_scene(&gpu, &model, &options, &|d, t| {
+                let run =
+                    headless::render_sequence(&gpu, &model, &mut player, &options, &|d, t| {
                         progress.update(d as u64, t as u64, None);
                     });
-                    progress.end();
-                    (run?, ViewKind::Scene)
-                }
+                progress.end();
+                (run?, ViewKind::Sequence)
             } else {
-                let mut model = ProbeModel::open(&self.input, self.mapping)?;
-                let mut inputs = extras.inputs();
-                inputs.push(self.input.clone());
-                check_outputs(outputs.as_ref(), &inputs)?;
-                let mut settings = self.probe_settings(&model)?;
-                extras.check()?;
-                extras.aim(&mut settings.orbit)?;
-                let room = extras.overlay()?;
-                if let (Some(room), Some(edit)) = (&extras.room, &extras.edit) {
-                    progress.begin("room: estimate and edits", 0);
-                    let edited = crate::room_edit::edited_panorama(room, edit, &model.latlong);
-                    progress.end();
-                    model.latlong = std::sync::Arc::new(edited?);
-                }
                 let gpu = GpuContext::headless()?;
                 progress.begin("frames", frames);
-                let run = headless::render_probe_with(
-                    &gpu,
-                    &model,
-                    &settings,
-                    &options,
-                    room.as_ref(),
-                    &|d, t| {
-                        progress.update(d as u64, t as u64, None);
-                    },
-                );
+                let run = headless::render_scene(&gpu, &model, &options, &|d, t| {
+                    progress.update(d as u64, t as u64, None);
+                });
                 progress.end();
-                (run?, ViewKind::Probe)
-            };
+                (run?, ViewKind::Scene)
+            }
+        } else {
+            let mut model = ProbeModel::open(&self.input, self.mapping)?;
+            let mut inputs = extras.inputs();
+            inputs.push(self.input.clone());
+            check_outputs(outputs.as_ref(), &inputs)?;
+            let mut settings = self.probe_settings(&model)?;
+            extras.check()?;
+            extras.aim(&mut settings.orbit)?;
+            let room = extras.overlay()?;
+            if let (Some(room), Some(edit)) = (&extras.room, &extras.edit) {
+                progress.begin("room: estimate and edits", 0);
+                let edited = crate::room_edit::edited_panorama(room, edit, &model.latlong);
+                progress.end();
+                model.latlong = std::sync::Arc::new(edited?);
+            }
+            let gpu = GpuContext::headless()?;
+            progress.begin("frames", frames);
+            let run = headless::render_probe_with(
+                &gpu,
+                &model,
+                &settings,
+                &options,
+                room.as_ref(),
+                &|d, t| {
+                    progress.update(d as u64, t as u64, None);
+                },
+            );
+            progress.end();
+            (run?, ViewKind::Probe)
+        };
         let mut written = Vec::new();
         if let Some((png, exr)) = &outputs {
             write_frame(&run, png, exr)?;
@@ -492,6 +478,38 @@ impl ViewJob {
             });
         }
         Ok(summary)
+    }
+}
+
+impl ViewJob {
+    /// The frames of a room's live display (`extras.live_room()`: `room` and `edit`) with
+    /// `options` (its display is set here, from the scene).
+    fn run_live(
+        &self,
+        room: &Path,
+        edit: &Path,
+        extras: &ProbeExtras,
+        outputs: Option<&(PathBuf, PathBuf)>,
+        options: &mut HeadlessOptions,
+        progress: &dyn Progress,
+    ) -> Result<HeadlessRun, ViewerError> {
+        extras.check()?;
+        let mut inputs = extras.inputs();
+        inputs.push(self.input.clone());
+        check_outputs(outputs, &inputs)?;
+        progress.begin("room: estimate, edits, volume", 0);
+        let live = crate::room_live::room_live(room, edit, progress);
+        progress.end();
+        let live = live?;
+        options.display = Some(self.display(headless::auto_exposure(&live.model))?);
+        let gpu = GpuContext::headless()?;
+        progress.begin("frames", u64::from(options.frames));
+        let run =
+            headless::render_scene_lit(&gpu, &live.model, live.lighting, 0.0, options, &|d, t| {
+                progress.update(d as u64, t as u64, None);
+            });
+        progress.end();
+        run
     }
 }
 

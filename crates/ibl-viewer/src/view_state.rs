@@ -202,7 +202,7 @@ impl Content {
                 "--marks, --room, --yaw, --pitch and --fov apply to a probe, not a scene".into(),
             ));
         }
-        if let (true, Some(room), Some(edit)) = (extras.live, &extras.room, &extras.edit) {
+        if let Some((room, edit)) = extras.live_room() {
             extras.check()?;
             let live = crate::room_live::room_live(room, edit, &ibl_pipeline::progress::Silent)?;
             let mut renderer = SceneRenderer::new(gpu, &live.model, size.0, size.1, shadow_tile)?;
