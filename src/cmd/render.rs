@@ -97,6 +97,10 @@ pub struct RenderArgs {
     /// Random numbers of the samples (default: the scene's `[render] sampler`, sobol).
     #[arg(long, value_enum)]
     pub sampler: Option<SamplerArg>,
+    /// Give every pixel all its samples in the lights and hybrid modes (default: the scene's
+    /// `[lighting] adaptive`, on: one sample first, the rest only where neighbours differ).
+    #[arg(long)]
+    pub no_adaptive: bool,
     /// Output width in pixels (panorama: height = width / 2; photo: its aspect ratio).
     #[arg(long, value_name = "W")]
     pub width: Option<u32>,
@@ -136,6 +140,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             SamplerArg::Sobol => SamplerKind::Sobol,
             SamplerArg::Independent => SamplerKind::Independent,
         }),
+        no_adaptive: args.no_adaptive,
         width: args.width,
         bounces: args.bounces,
         seed: args.seed,
@@ -154,21 +159,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     if args.json {
         println!("{}", serde_json::to_string_pretty(&summary)?);
     } else {
-        println!(
-            "{}: {} x {}, {} spp, {} mode{}: {:.2} s, {:.1} M rays/s; wrote {}",
-            summary.scene,
-            summary.width,
-            summary.height,
-            summary.spp,
-            summary.mode,
-            summary.lights.as_ref().map_or(String::new(), |l| format!(
-                " ({} lights, {} shadows)",
-                l.count, l.shadows
-            )),
-            summary.seconds_render,
-            summary.rays_per_second / 1e6,
-            summary.outputs.join(", ")
-        );
+        println!("{summary}");
     }
     Ok(())
 }

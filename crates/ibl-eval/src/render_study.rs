@@ -54,6 +54,9 @@ pub struct RenderStudySettings {
     pub reference_spp: u32,
     /// Samples per pixel of the light renders (antialiasing and soft-shadow samples).
     pub lights_spp: u32,
+    /// Adaptive antialiasing of the light renders (`ibl_render::adaptive`): the contrast above
+    /// which a pixel takes all `lights_spp`, or `None` for all of them everywhere.
+    pub lights_adaptive: Option<f32>,
     /// Surface vertices per path, the same in every render.
     pub bounces: u32,
     /// Random numbers of every render.
@@ -127,8 +130,10 @@ pub struct RenderStudy {
     pub height: u32,
     /// Samples per pixel of the reference.
     pub reference_spp: u32,
-    /// Samples per pixel of the light renders.
+    /// Samples per pixel of the light renders (the most a pixel takes).
     pub lights_spp: u32,
+    /// Adaptive antialiasing's contrast threshold of the light renders (`None`: off).
+    pub lights_adaptive: Option<f32>,
     /// Bounces of every render.
     pub bounces: u32,
     /// Random numbers of every render.
@@ -155,7 +160,7 @@ pub struct RenderStudyImages {
     pub lights: Vec<(String, usize, RenderOutput)>,
 }
 
-fn settings(s: &RenderStudySettings, spp: u32, seed: u64) -> RenderSettings {
+fn settings(s: &RenderStudySettings, spp: u32, seed: u64, adaptive: Option<f32>) -> RenderSettings {
     RenderSettings {
         composite: CompositeRule::Difference,
         width: s.width,
@@ -163,6 +168,7 @@ fn settings(s: &RenderStudySettings, spp: u32, seed: u64) -> RenderSettings {
         bounces: s.bounces,
         seed,
         sampler: s.sampler,
+        adaptive,
     }
 }
 
@@ -235,7 +241,7 @@ pub fn render_study(
     let reference = render(
         scene,
         &reference_lighting,
-        &settings(s, s.reference_spp, s.seed),
+        &settings(s, s.reference_spp, s.seed, None),
         &no_rows,
     )?;
     let seconds_reference = started.elapsed().as_secs_f64();
@@ -243,7 +249,7 @@ pub fn render_study(
     let second = render(
         scene,
         &reference_lighting,
-        &settings(s, s.reference_spp, s.seed.wrapping_add(0x9e37_79b9)),
+        &settings(s, s.reference_spp, s.seed.wrapping_add(0x9e37_79b9), None),
         &no_rows,
     )?;
     let (noise_relative_mse, _, noise_flip) = score(&second.with_objects, &reference.with_objects)?;
@@ -275,7 +281,7 @@ pub fn render_study(
         let out = render(
             scene,
             &lighting,
-            &settings(s, s.lights_spp, s.seed),
+            &settings(s, s.lights_spp, s.seed, s.lights_adaptive),
             &no_rows,
         )?;
         let seconds_render = started.elapsed().as_secs_f64();
@@ -302,6 +308,7 @@ pub fn render_study(
         height: reference.stats.height,
         reference_spp: s.reference_spp,
         lights_spp: s.lights_spp,
+        lights_adaptive: s.lights_adaptive,
         bounces: s.bounces,
         sampler: s.sampler.name().to_string(),
         seconds_reference,
@@ -352,7 +359,7 @@ impl RenderStudy {
         let counts = self.counts();
         let mut md = format!(
             "### {}: light renders against the path-traced reference\n\n\
-             {} x {} pixels; reference {} spp, light renders {} spp ({} sampler), {} bounce(s); \
+             {} x {} pixels; reference {} spp, light renders {} spp{} ({} sampler), {} bounce(s); \
              soft shadows unless marked; reference rendered in {:.2} s. Its own noise (half the \
              relative MSE of two references with different seeds; their FLIP): \
              **{:.2e} / {:.3}**, the floor of the table.\n\n\
@@ -363,6 +370,10 @@ impl RenderStudy {
             self.height,
             self.reference_spp,
             self.lights_spp,
+            match self.lights_adaptive {
+                Some(c) => format!(" at most, adaptive (contrast {c})"),
+                None => String::new(),
+            },
             self.sampler,
             self.bounces,
             self.seconds_reference,

@@ -35,7 +35,10 @@ pub fn edited_scene_text(
     let serialize = |d: &SceneDescription| {
         toml_edit::ser::to_document(d).map_err(|e| SceneWriteError::Serialize(e.to_string()))
     };
-    let old = serialize(original)?;
+    // Both sides shortened alike, so a float field the file leaves to its default (an f32
+    // such as 0.04, whose f64 is 0.03999999910593033) compares equal to itself.
+    let mut old = serialize(original)?;
+    shorten_floats(old.as_item_mut());
     let mut new = serialize(edited)?;
     shorten_floats(new.as_item_mut());
     merge_table(

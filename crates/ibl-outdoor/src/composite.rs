@@ -183,6 +183,7 @@ impl FrameCompositor {
             bounces: 1,
             seed: self.settings.seed,
             sampler: SamplerKind::Sobol,
+            adaptive: None,
         };
         Ok(render(
             &scene,

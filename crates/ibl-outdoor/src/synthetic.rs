@@ -250,6 +250,7 @@ impl SyntheticDay {
             // Independent numbers: the truths' stated noise (docs/OUTDOOR.md) was measured with
             // them, and their error is an unbiased standard error per pixel.
             sampler: SamplerKind::Independent,
+            adaptive: None,
         }
     }
 

@@ -405,6 +405,7 @@ fn study(
         width: Some(STUDY_WIDTH),
         reference_spp: STUDY_REFERENCE_SPP,
         lights_spp: lights_defaults.spp,
+        lights_adaptive: lights_defaults.adaptive,
         bounces: 1,
         sampler: lights_defaults.sampler,
         occlusion_rays: base.occlusion_rays,

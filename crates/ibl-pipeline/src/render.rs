@@ -64,6 +64,9 @@ pub struct RenderJob {
     pub spp: Option<u32>,
     /// Random numbers of the samples.
     pub sampler: Option<SamplerKind>,
+    /// Every pixel takes all its samples in the lights and hybrid modes (`false`: the scene's
+    /// `[lighting] adaptive`, on by default).
+    pub no_adaptive: bool,
     /// Output width in pixels.
     pub width: Option<u32>,
     /// Surface vertices per path.
@@ -100,8 +103,12 @@ pub struct RenderSummary {
     pub width: u32,
     /// Height in pixels.
     pub height: u32,
-    /// Samples per pixel.
+    /// Samples per pixel (the most a pixel takes with adaptive antialiasing).
     pub spp: u32,
+    /// Adaptive antialiasing's contrast threshold (lights and hybrid modes; `None`: off).
+    pub adaptive_contrast: Option<f32>,
+    /// Pixels that took all `spp` samples.
+    pub refined_pixels: u64,
     /// Bounces.
     pub bounces: u32,
     /// Seed.
@@ -128,6 +135,36 @@ pub struct RenderSummary {
     pub virtual_triangles: usize,
     /// Files written.
     pub outputs: Vec<String>,
+}
+
+/// The one-line summary `ibl render` prints: size, samples (with the share of pixels adaptive
+/// antialiasing refined), mode and lights, time, ray rate and the files written.
+impl std::fmt::Display for RenderSummary {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let pixels = (u64::from(self.width) * u64::from(self.height)).max(1);
+        let spp = match self.adaptive_contrast {
+            Some(_) => format!(
+                "up to {} spp ({:.0} % of pixels refined)",
+                self.spp,
+                100.0 * self.refined_pixels as f64 / pixels as f64
+            ),
+            None => format!("{} spp", self.spp),
+        };
+        let lights = self.lights.as_ref().map_or(String::new(), |l| {
+            format!(" ({} lights, {} shadows)", l.count, l.shadows)
+        });
+        write!(
+            f,
+            "{}: {} x {}, {spp}, {} mode{lights}: {:.2} s, {:.1} M rays/s; wrote {}",
+            self.scene,
+            self.width,
+            self.height,
+            self.mode,
+            self.seconds_render,
+            self.rays_per_second / 1e6,
+            self.outputs.join(", ")
+        )
+    }
 }
 
 /// Reads the scene, builds the lighting, renders and writes the images.
@@ -178,6 +215,7 @@ pub fn render_scene(job: &RenderJob, progress: &dyn Progress) -> Result<RenderSu
         bounces: job.bounces.unwrap_or(defaults.bounces),
         seed: job.seed.unwrap_or(defaults.seed),
         sampler: job.sampler.unwrap_or(defaults.sampler),
+        adaptive: defaults.adaptive.filter(|_| !job.no_adaptive),
         ..defaults
     };
     check_settings(&settings)?;
@@ -212,6 +250,10 @@ pub fn render_scene(job: &RenderJob, progress: &dyn Progress) -> Result<RenderSu
         width: stats.width,
         height: stats.height,
         spp: stats.spp,
+        adaptive_contrast: settings
+            .adaptive
+            .filter(|_| plan.mode != RenderMode::Reference),
+        refined_pixels: stats.refined_pixels,
         bounces: settings.bounces,
         seed: settings.seed,
         sampler: settings.sampler.name(),

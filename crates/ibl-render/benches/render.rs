@@ -36,6 +36,7 @@ fn bench_rays(c: &mut Criterion) {
         bounces: 4,
         seed: 1,
         sampler: SamplerKind::Sobol,
+        adaptive: None,
     };
     let rays = render(&scene, &lighting, &settings, &|_, _| {})
         .expect("render")
@@ -71,6 +72,7 @@ fn bench_differential(c: &mut Criterion) {
         bounces: 1,
         seed: 1,
         sampler: SamplerKind::Sobol,
+        adaptive: None,
     };
     let mut group = c.benchmark_group("differential");
     group.sample_size(10);

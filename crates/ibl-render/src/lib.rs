@@ -5,6 +5,7 @@
 //! - [`mod@render`]: the driver and the differential composite (with and without the objects).
 //! - [`tracer`]: one light path, in the reference, lights or hybrid mode.
 //! - [`lighting`]: what lights each mode (environment, directional lights, lights + SH ambient).
+//! - [`adaptive`]: adaptive antialiasing of the lights and hybrid modes.
 //! - [`background`]: the background at the output size.
 //! - [`environment`]: the probe as an importance-sampled environment light.
 //! - [`footprint`]: the probe's mean over a pinhole pixel's footprint (the background).
@@ -12,6 +13,7 @@
 //! - [`sampler`]: the numbers each pixel sample draws (Owen-scrambled Sobol or independent).
 //! - [`sampling`]: random number generator, warps and discrete distributions.
 
+pub mod adaptive;
 pub mod background;
 pub mod environment;
 pub mod footprint;

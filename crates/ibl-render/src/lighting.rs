@@ -48,7 +48,7 @@ use glam::{DMat3, DVec3, Vec3};
 use ibl_core::Rgb;
 use ibl_light::{GoniometricLight, LightSet};
 use ibl_scene::{Scene, ShadowKind};
-use ibl_sh::{RadianceSh, basis, eval_basis};
+use ibl_sh::{IrradianceSh, RadianceSh, Window, basis, eval_basis};
 
 use crate::environment::{EnvironmentError, EnvironmentLight};
 use crate::sampling::{OrthonormalBasis, UniformCone};
@@ -84,6 +84,9 @@ pub struct Ambient {
     /// The ambient radiance (probe units, world frame), cut to at most [`MAX_AMBIENT_BANDS`]
     /// bands.
     sh: RadianceSh,
+    /// Its irradiance (the Lambert convolution of `sh`, no window): what the ambient gives a
+    /// surface that nothing occludes.
+    irradiance: IrradianceSh,
     /// Occlusion rays per shading point, at least 1.
     pub occlusion_rays: u32,
 }
@@ -92,8 +95,10 @@ impl Ambient {
     /// The ambient of radiance `radiance` (world frame; its bands are cut to
     /// [`MAX_AMBIENT_BANDS`]) with `occlusion_rays` rays per shading point (at least 1).
     pub fn new(radiance: &RadianceSh, occlusion_rays: u32) -> Ambient {
+        let sh = radiance.truncated(MAX_AMBIENT_BANDS);
         Ambient {
-            sh: radiance.truncated(MAX_AMBIENT_BANDS),
+            irradiance: sh.irradiance(Window::None),
+            sh,
             occlusion_rays: occlusion_rays.max(1),
         }
     }
@@ -106,18 +111,29 @@ impl Ambient {
     /// The ambient radiance arriving from the unit world direction `dir` (may be negative:
     /// the ambient is a difference). O(bands^2).
     pub fn radiance(&self, dir: Vec3) -> Rgb {
-        let mut y = [0.0f64; MAX_AMBIENT_BANDS * MAX_AMBIENT_BANDS];
-        let bands = self.sh.bands();
-        let n = bands * bands;
-        eval_basis(dir.as_dvec3(), bands, &mut y[..n]);
-        let mut sum = [0.0f64; 3];
-        for (c, yk) in self.sh.coefficients().iter().zip(&y[..n]) {
-            for k in 0..3 {
-                sum[k] += c[k] * yk;
-            }
-        }
-        Rgb::new(sum[0] as f32, sum[1] as f32, sum[2] as f32)
+        evaluate(self.sh.bands(), self.sh.coefficients(), dir)
     }
+
+    /// The ambient irradiance on an unoccluded surface of unit normal `n` (world frame; may be
+    /// negative), `int max(0, n . w) L_a(w) dw` (Ramamoorthi and Hanrahan 2001). O(bands^2).
+    pub fn irradiance(&self, n: Vec3) -> Rgb {
+        evaluate(self.irradiance.bands(), self.irradiance.coefficients(), n)
+    }
+}
+
+/// An SH expansion of `bands` bands with RGB coefficients `coefficients`, at the unit direction
+/// `dir`, without allocating. O(bands^2).
+fn evaluate(bands: usize, coefficients: &[[f64; 3]], dir: Vec3) -> Rgb {
+    let mut y = [0.0f64; MAX_AMBIENT_BANDS * MAX_AMBIENT_BANDS];
+    let n = bands * bands;
+    eval_basis(dir.as_dvec3(), bands, &mut y[..n]);
+    let mut sum = [0.0f64; 3];
+    for (c, yk) in coefficients.iter().zip(&y[..n]) {
+        for k in 0..3 {
+            sum[k] += c[k] * yk;
+        }
+    }
+    Rgb::new(sum[0] as f32, sum[1] as f32, sum[2] as f32)
 }
 
 /// How diffuse and glossy surfaces are lit.

@@ -23,6 +23,7 @@
 //! samples in order: the image depends on the seed only, never on the thread count. Cost:
 //! O(W H n) paths (see [`crate::tracer`] per path).
 
+use std::ops::Range;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use ibl_core::{Image, Rgb};
@@ -32,13 +33,14 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::RenderError;
+use crate::adaptive::{FirstSample, needs_refinement};
 use crate::background::background_image;
-use crate::lighting::Lighting;
+use crate::lighting::{Illumination, Lighting};
 use crate::sampler::{SOBOL_MAX_SAMPLES, SampleStream, SamplerKind};
-use crate::tracer::{Layers, PrimaryHit, Tracer};
+use crate::tracer::{KnownVisibility, Layers, LightVisibility, PrimaryHit, ShadowHints, Tracer};
 
 /// How to render.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RenderSettings {
     /// How the objects' effect on real surfaces joins the background.
     pub composite: CompositeRule,
@@ -53,6 +55,10 @@ pub struct RenderSettings {
     pub seed: u64,
     /// Which random numbers the samples draw.
     pub sampler: SamplerKind,
+    /// Adaptive antialiasing ([`crate::adaptive`]): `Some(c)` gives every pixel one sample first
+    /// and all `spp` only where its neighbourhood shows a contrast above `c` or a silhouette;
+    /// `None` gives every pixel `spp`. Ignored by the reference mode, which stays unbiased.
+    pub adaptive: Option<f32>,
 }
 
 impl RenderSettings {
@@ -71,6 +77,13 @@ impl RenderSettings {
             bounces: r.bounces,
             seed: r.seed,
             sampler: r.sampler,
+            adaptive: match mode {
+                RenderMode::Reference => None,
+                RenderMode::Lights | RenderMode::Hybrid => scene
+                    .lighting
+                    .adaptive
+                    .then_some(scene.lighting.adaptive_contrast),
+            },
         }
     }
 }
@@ -82,8 +95,11 @@ pub struct RenderStats {
     pub width: u32,
     /// Output height, pixels.
     pub height: u32,
-    /// Samples per pixel.
+    /// Samples per pixel (the most a pixel takes, with adaptive antialiasing).
     pub spp: u32,
+    /// Pixels that took all `spp` samples: every pixel without adaptive antialiasing, those
+    /// whose first samples showed contrast with it.
+    pub refined_pixels: u64,
     /// Paths traced with the objects.
     pub paths: u64,
     /// Paths traced again without the objects (they touched a virtual object).
@@ -114,6 +130,10 @@ pub struct RenderOutput {
 /// One pixel's sums.
 #[derive(Clone, Copy, Default)]
 struct PixelSums {
+    /// Samples taken.
+    samples: u32,
+    /// What blocked each light at the first sample's camera hit (adaptive antialiasing).
+    first_visibility: LightVisibility,
     object: Rgb,
     /// Sums over the samples whose primary ray met real geometry, with and without the objects
     /// (the ratio rule).
@@ -160,23 +180,64 @@ pub fn render(
     let background = background_image(scene, width, height);
     let tracer = Tracer::new(scene, lighting, settings.bounces);
     let (w, h) = (width as usize, height as usize);
+    let sampler = PixelSampler {
+        tracer: &tracer,
+        scene,
+        settings,
+        width,
+        height,
+    };
+    // Adaptive antialiasing: only the light modes, and only when a pixel has more than one
+    // sample to save.
+    let adaptive = settings.adaptive.filter(|_| {
+        settings.spp > 1 && !matches!(lighting.illumination, Illumination::Environment)
+    });
     let rows_done = AtomicUsize::new(0);
-    let rows: Vec<Vec<PixelSums>> = (0..h)
-        .into_par_iter()
-        .map(|y| {
-            let row = (0..w)
-                .map(|x| pixel(&tracer, scene, settings, x, y, width, height))
+    let passes = if adaptive.is_some() { 2 } else { 1 };
+    let row_done = || progress(rows_done.fetch_add(1, Ordering::Relaxed) + 1, passes * h);
+    let sums: Vec<PixelSums> = match adaptive {
+        None => (0..h)
+            .into_par_iter()
+            .flat_map_iter(|y| {
+                let mut hints = ShadowHints::default();
+                let row: Vec<PixelSums> = (0..w)
+                    .map(|x| sampler.samples(x, y, 0..settings.spp, &mut hints))
+                    .collect();
+                row_done();
+                row
+            })
+            .collect(),
+        Some(contrast) => {
+            // Pass 1: sample 0 of every pixel; pass 2: samples 1.. where the first samples of the
+            // pixel's neighbourhood differ (crate::adaptive).
+            let mut sums: Vec<PixelSums> = (0..h)
+                .into_par_iter()
+                .flat_map_iter(|y| {
+                    let mut hints = ShadowHints::default();
+                    let row: Vec<PixelSums> = (0..w)
+                        .map(|x| sampler.samples(x, y, 0..1, &mut hints))
+                        .collect();
+                    row_done();
+                    row
+                })
                 .collect();
-            progress(rows_done.fetch_add(1, Ordering::Relaxed) + 1, h);
-            row
-        })
-        .collect();
-    let n = settings.spp as f32;
+            let first: Vec<FirstSample> = sums.iter().map(PixelSums::first_sample).collect();
+            sums.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+                let mut hints = ShadowHints::default();
+                for (x, pixel) in row.iter_mut().enumerate() {
+                    if let Some(known) = needs_refinement(&first, w, h, x, y, contrast) {
+                        sampler.add_samples(pixel, x, y, 1..settings.spp, &mut hints, &known);
+                    }
+                }
+                row_done();
+            });
+            sums
+        }
+    };
     let mut stats = RenderStats {
         width,
         height,
         spp: settings.spp,
-        paths: w as u64 * h as u64 * u64::from(settings.spp),
         ..RenderStats::default()
     };
     let mut composite = Vec::with_capacity(w * h);
@@ -184,8 +245,9 @@ pub fn render(
     let mut without_objects = Vec::with_capacity(w * h);
     let mut coverage = Vec::with_capacity(w * h);
     let mut object_samples = 0u64;
-    for (sums, &b) in rows.iter().flatten().zip(background.pixels()) {
-        let other = settings.spp - sums.object_samples;
+    for (sums, &b) in sums.iter().zip(background.pixels()) {
+        let n = sums.samples as f32;
+        let other = sums.samples - sums.object_samples;
         let c = match settings.composite {
             CompositeRule::Difference => {
                 b * (other as f32 / n) + (sums.object + sums.difference) / n
@@ -229,6 +291,8 @@ pub fn render(
         without_objects.push((sums.without + bg) / n);
         coverage.push(sums.object_samples as f32 / n);
         object_samples += u64::from(sums.object_samples);
+        stats.paths += u64::from(sums.samples);
+        stats.refined_pixels += u64::from(sums.samples == settings.spp);
         stats.paths_without_objects += sums.paths_without;
         stats.rays += sums.rays;
     }
@@ -249,70 +313,128 @@ pub fn render(
 /// Largest output, pixels (a 16384 x 8192 panorama).
 pub const MAX_PIXELS: usize = 16384 * 8192;
 
-fn pixel(
-    tracer: &Tracer,
-    scene: &Scene,
-    settings: &RenderSettings,
-    x: usize,
-    y: usize,
+impl PixelSums {
+    /// What the pixel's one sample saw (adaptive antialiasing's first pass).
+    fn first_sample(&self) -> FirstSample {
+        let primary = if self.object_samples > 0 {
+            PrimaryHit::Virtual
+        } else if self.background_samples > 0 {
+            PrimaryHit::Background
+        } else {
+            PrimaryHit::Real
+        };
+        FirstSample {
+            primary,
+            with: self.with,
+            without: self.without,
+            visibility: self.first_visibility,
+        }
+    }
+}
+
+/// Traces the samples of pixels: everything a pixel's samples share.
+struct PixelSampler<'a> {
+    tracer: &'a Tracer<'a>,
+    scene: &'a Scene,
+    settings: &'a RenderSettings,
     width: u32,
     height: u32,
-) -> PixelSums {
-    let index = (y as u64) * u64::from(width) + x as u64;
-    let mut sums = PixelSums::default();
-    // The stream of sample `s`, and the same stream after its pixel jitter (the pass without the
-    // objects draws exactly the numbers the pass with them drew).
-    let stream = |s: u32| SampleStream::new(settings.sampler, settings.seed, index, s);
-    let after_jitter = |s: u32| {
-        let mut stream = stream(s);
-        stream.next_2d();
-        stream
-    };
-    for s in 0..settings.spp {
-        let mut rng = stream(s);
-        let [jx, jy] = rng.next_2d();
-        let ray = scene
-            .camera
-            .ray(x as f32 + jx, y as f32 + jy, width, height);
-        let with = tracer.trace(ray, Layers::WithObjects, &mut rng);
-        sums.rays += with.rays;
-        match with.primary {
-            PrimaryHit::Virtual => {
-                sums.object += with.radiance;
-                sums.with += with.radiance;
-                sums.object_samples += 1;
-                // The same camera ray without the objects, for the "without" layer.
-                let without = tracer.trace(ray, Layers::RealOnly, &mut after_jitter(s));
-                sums.without += without.radiance;
-                sums.rays += without.rays;
-                sums.paths_without += 1;
+}
+
+impl PixelSampler<'_> {
+    /// The sums of samples `samples` of pixel `(x, y)`.
+    fn samples(
+        &self,
+        x: usize,
+        y: usize,
+        samples: Range<u32>,
+        hints: &mut ShadowHints,
+    ) -> PixelSums {
+        let mut sums = PixelSums::default();
+        self.add_samples(&mut sums, x, y, samples, hints, &KnownVisibility::NONE);
+        sums
+    }
+
+    /// Adds samples `samples` of pixel `(x, y)` to `sums`, in order (`hints`: the thread's
+    /// shadow cache, [`ShadowHints`]; `known`: shadow answers to take instead of tracing).
+    fn add_samples(
+        &self,
+        sums: &mut PixelSums,
+        x: usize,
+        y: usize,
+        samples: Range<u32>,
+        hints: &mut ShadowHints,
+        known: &KnownVisibility,
+    ) {
+        let (tracer, settings) = (self.tracer, self.settings);
+        let index = (y as u64) * u64::from(self.width) + x as u64;
+        // The stream of sample `s`, and the same stream after its pixel jitter (the pass without
+        // the objects draws exactly the numbers the pass with them drew).
+        let stream = |s: u32| SampleStream::new(settings.sampler, settings.seed, index, s);
+        let after_jitter = |s: u32| {
+            let mut stream = stream(s);
+            stream.next_2d();
+            stream
+        };
+        for s in samples {
+            sums.samples += 1;
+            let mut rng = stream(s);
+            let [jx, jy] = rng.next_2d();
+            let ray = self
+                .scene
+                .camera
+                .ray(x as f32 + jx, y as f32 + jy, self.width, self.height);
+            let with = tracer.trace(ray, Layers::WithObjects, &mut rng, hints, known);
+            if sums.samples == 1 {
+                sums.first_visibility = with.visibility;
             }
-            PrimaryHit::Background => sums.background_samples += 1,
-            PrimaryHit::Real => {
-                sums.with += with.radiance;
-                if with.touched_virtual {
-                    // The lights and hybrid modes usually evaluated the path without the objects
-                    // in the same walk; otherwise it is walked again through the real layer.
-                    let without = match with.without_objects {
-                        Some(radiance) => radiance,
-                        None => {
-                            let again = tracer.trace(ray, Layers::RealOnly, &mut after_jitter(s));
-                            sums.rays += again.rays;
-                            sums.paths_without += 1;
-                            again.radiance
+            sums.rays += with.rays;
+            match with.primary {
+                PrimaryHit::Virtual => {
+                    sums.object += with.radiance;
+                    sums.with += with.radiance;
+                    sums.object_samples += 1;
+                    // The same camera ray without the objects, for the "without" layer.
+                    let without = tracer.trace(
+                        ray,
+                        Layers::RealOnly,
+                        &mut after_jitter(s),
+                        hints,
+                        &KnownVisibility::NONE,
+                    );
+                    sums.without += without.radiance;
+                    sums.rays += without.rays;
+                    sums.paths_without += 1;
+                }
+                PrimaryHit::Background => sums.background_samples += 1,
+                PrimaryHit::Real => {
+                    sums.with += with.radiance;
+                    let without = if with.touched_virtual {
+                        // The lights and hybrid modes usually evaluated the path without the
+                        // objects in the same walk; otherwise it is walked again through the real
+                        // layer.
+                        match with.without_objects {
+                            Some(radiance) => radiance,
+                            None => {
+                                let again = tracer.trace(
+                                    ray,
+                                    Layers::RealOnly,
+                                    &mut after_jitter(s),
+                                    hints,
+                                    &KnownVisibility::NONE,
+                                );
+                                sums.rays += again.rays;
+                                sums.paths_without += 1;
+                                again.radiance
+                            }
                         }
+                    } else {
+                        // The same path without the objects: bit for bit this one, less the new
+                        // lights' share (the goniometric lights, absent without the objects; the
+                        // lights and hybrid modes evaluated it in the walk).
+                        with.without_objects
+                            .unwrap_or(with.radiance - with.new_light)
                     };
-                    sums.without += without;
-                    sums.difference += with.radiance - without;
-                    sums.real_with += with.radiance;
-                    sums.real_without += without;
-                } else {
-                    // The same path without the objects: bit for bit this one, less the new
-                    // lights' share (the goniometric lights, absent without the objects; the
-                    // lights and hybrid modes evaluated it in the walk).
-                    let without = with
-                        .without_objects
-                        .unwrap_or(with.radiance - with.new_light);
                     sums.without += without;
                     sums.difference += with.radiance - without;
                     sums.real_with += with.radiance;
@@ -321,5 +443,4 @@ fn pixel(
             }
         }
     }
-    sums
 }

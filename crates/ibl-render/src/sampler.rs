@@ -83,6 +83,12 @@ impl SobolStream {
         ]
     }
 
+    /// Passes over the next pair without computing it: the pairs after it are those a
+    /// [`SobolStream::next_2d`] here would have left.
+    pub fn skip_2d(&mut self) {
+        self.pair += 1;
+    }
+
     /// The next number: the first coordinate of a fresh pair.
     pub fn next_1d(&mut self) -> f32 {
         let seed = self.next_seed();
@@ -171,6 +177,19 @@ impl SampleStream {
         }
     }
 
+    /// Passes over the next pair (two numbers of the independent stream) without using it:
+    /// the later draws are those after a [`SampleStream::next_2d`].
+    #[inline]
+    pub fn skip_2d(&mut self) {
+        match self {
+            SampleStream::Sobol(s) => s.skip_2d(),
+            SampleStream::Independent(r) => {
+                r.next_f32();
+                r.next_f32();
+            }
+        }
+    }
+
     /// One number in `[0, 1)`.
     #[inline]
     pub fn next_1d(&mut self) -> f32 {
@@ -217,6 +236,18 @@ mod tests {
             assert_ne!(draw(1, 2, 3), draw(2, 2, 3));
             assert_ne!(draw(1, 2, 3), draw(1, 3, 3));
             assert_ne!(draw(1, 2, 3), draw(1, 2, 4));
+        }
+    }
+
+    #[test]
+    fn a_skipped_pair_leaves_the_later_draws_unchanged() {
+        for kind in [SamplerKind::Sobol, SamplerKind::Independent] {
+            let mut drawn = SampleStream::new(kind, 7, 11, 3);
+            let mut skipped = drawn.clone();
+            drawn.next_2d();
+            skipped.skip_2d();
+            assert_eq!(drawn.next_2d(), skipped.next_2d());
+            assert_eq!(drawn.next_1d(), skipped.next_1d());
         }
     }
 }

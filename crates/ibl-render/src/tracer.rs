@@ -13,8 +13,9 @@
 //!   mirror bounces, which are followed exactly) every light is evaluated with its own shadow ray:
 //!   along its direction (hard) or towards a point of its cone drawn from one 2-D sample of the
 //!   pixel sample's stream (soft; the Sobol stream stratifies each light's cone points across the
-//!   pixel's samples). The path then ends: there is no indirect light, and no noise but the
-//!   antialiasing and soft-shadow sampling. Escaping rays add the probe only after a mirror.
+//!   pixel's samples, and the cone's unshadowed light is exact: `Tracer::lights`). The path then
+//!   ends: there is no indirect light, and no noise but the antialiasing and the soft shadows'
+//!   visibility samples. Escaping rays add the probe only after a mirror.
 //! - **hybrid**: as lights, plus the ambient radiance `L_a` seen through `k` cosine-distributed
 //!   occlusion rays: `albedo * mean_k V(w_k) L_a(w_k)` (directional occlusion,
 //!   [`crate::lighting`]).
@@ -51,12 +52,13 @@
 
 use glam::Vec3;
 use ibl_core::Rgb;
+use ibl_scene::bvh::OccluderHint;
 use ibl_scene::{Hit, Ray, Scene, ShadowKind, SurfacePoint};
 
-use crate::lighting::{Ambient, DirectionalLight, Illumination, LightList, Lighting};
+use crate::lighting::{Ambient, Illumination, LightList, Lighting};
 use crate::material::Bsdf;
 use crate::sampler::SampleStream;
-use crate::sampling::{OrthonormalBasis, power_heuristic, sample_cosine_hemisphere};
+use crate::sampling::{OrthonormalBasis, UniformCone, power_heuristic, sample_cosine_hemisphere};
 
 /// Which layers a path may meet.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -97,6 +99,79 @@ pub struct PathRecord {
     /// absent from the scene without the objects (a path that never touched the virtual layer
     /// is, without the objects, `radiance - new_light`).
     pub new_light: Rgb,
+    /// What blocked each of the first [`VISIBILITY_LIGHTS`] lights' shadow rays at the shaded
+    /// vertex, when the camera ray's own hit was shaded (no mirror before it) in the lights or
+    /// hybrid mode with the objects; empty otherwise.
+    pub visibility: LightVisibility,
+}
+
+/// How many lights of a light list [`LightVisibility`] follows (one bit each).
+pub const VISIBILITY_LIGHTS: usize = 64;
+
+/// Per light of a light list (bit `i` for light `i < 64`), whether its shadow ray from one
+/// vertex was traced, and what blocked it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LightVisibility {
+    /// The lights whose shadow ray was traced (or known).
+    pub tested: u64,
+    /// Of those, the ones the real layer blocked.
+    pub real: u64,
+    /// Of those, the ones only the virtual layer blocked.
+    pub virtual_only: u64,
+}
+
+impl LightVisibility {
+    fn record(&mut self, index: usize, occlusion: Occlusion) {
+        if index < VISIBILITY_LIGHTS {
+            let bit = 1u64 << index;
+            self.tested |= bit;
+            match occlusion {
+                Occlusion::Open => {}
+                Occlusion::Real => self.real |= bit,
+                Occlusion::Virtual => self.virtual_only |= bit,
+            }
+        }
+    }
+
+    /// What blocked light `index`, when its bit is in `tested`.
+    fn occlusion(&self, index: usize) -> Option<Occlusion> {
+        let bit = 1u64
+            .checked_shl(index as u32)
+            .filter(|_| index < VISIBILITY_LIGHTS)?;
+        let occlusion = if self.real & bit != 0 {
+            Occlusion::Real
+        } else if self.virtual_only & bit != 0 {
+            Occlusion::Virtual
+        } else {
+            Occlusion::Open
+        };
+        (self.tested & bit != 0).then_some(occlusion)
+    }
+}
+
+/// Shadow answers a path may take instead of tracing (adaptive antialiasing's second pass,
+/// [`crate::adaptive`]): where every first sample around a pixel found a light's ray blocked the
+/// same way, the pixel's later samples take that answer for that light. Used only at a camera
+/// ray's own hit, with the objects, when it is of the same kind as the neighbourhood's
+/// (`primary`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct KnownVisibility {
+    /// What the camera rays of the neighbourhood met.
+    pub primary: PrimaryHit,
+    /// The lights whose answer is known (`tested`) and the answers.
+    pub lights: LightVisibility,
+}
+
+impl KnownVisibility {
+    /// Nothing known: every ray is traced.
+    pub const NONE: KnownVisibility = KnownVisibility {
+        primary: PrimaryHit::Background,
+        lights: LightVisibility {
+            tested: 0,
+            real: 0,
+            virtual_only: 0,
+        },
+    };
 }
 
 /// Whether a ray towards a distant light is blocked, and by which layer.
@@ -146,6 +221,20 @@ impl LayeredLight {
         }
     }
 
+    /// Adds `value` to the layers in which a ray blocked as `occlusion` is blocked (the
+    /// complement of [`LayeredLight::add`]).
+    #[inline]
+    fn add_blocked(&mut self, occlusion: Occlusion, value: Rgb) {
+        if occlusion != Occlusion::Open {
+            self.with += value;
+        }
+        if let Some(without) = &mut self.without
+            && occlusion == Occlusion::Real
+        {
+            *without += value;
+        }
+    }
+
     /// Adds `value` to the layers in which a ray blocked as `occlusion` is open.
     #[inline]
     fn add(&mut self, occlusion: Occlusion, value: Rgb) {
@@ -181,10 +270,54 @@ pub struct Tracer<'a> {
 const ROULETTE_FROM: u32 = 3;
 
 /// The query state of one path.
-struct PathState {
+struct PathState<'h> {
     layers: Layers,
     touched_virtual: bool,
     rays: u64,
+    hints: &'h mut ShadowHints,
+    /// Answers to take instead of tracing, at the vertex being shaded (emptied elsewhere).
+    known: LightVisibility,
+    /// The answers at the vertex being shaded (camera hits only).
+    seen: LightVisibility,
+}
+
+/// Per light, the triangles of the real and the virtual layer that last blocked its shadow ray
+/// ([`ibl_scene::bvh::Bvh::occluded_by`]): kept by the caller across the samples and pixels one
+/// thread traces, so that a shadow's neighbouring rays test their likely blocker first. Only a
+/// speed-up: every answer is the same with any hints.
+///
+/// It also keeps each soft light's last cone cosine ([`UniformCone::mean_clamped_cosine`]),
+/// which a flat surface asks for again and again with the same normal.
+#[derive(Clone, Debug, Default)]
+pub struct ShadowHints {
+    /// `[real, virtual]` per light of the light list.
+    lights: Vec<[OccluderHint; 2]>,
+    /// Per light, the last `(cos_beta, mean_clamped_cosine(cos_beta))`.
+    mean_cos: Vec<(f32, f32)>,
+}
+
+impl ShadowHints {
+    /// The hints of light `index`, made on first use.
+    fn light(&mut self, index: usize) -> &mut [OccluderHint; 2] {
+        if index >= self.lights.len() {
+            self.lights.resize(index + 1, [OccluderHint::NONE; 2]);
+        }
+        &mut self.lights[index]
+    }
+
+    /// `cone.mean_clamped_cosine(cos_beta)` for light `index` (whose cone is `cone`), computed
+    /// only when `cos_beta` differs from the light's last one: bit for bit the same value.
+    fn mean_cos(&mut self, index: usize, cone: UniformCone, cos_beta: f32) -> f32 {
+        if index >= self.mean_cos.len() {
+            self.mean_cos.resize(index + 1, (f32::NAN, 0.0));
+        }
+        let (last, value) = &mut self.mean_cos[index];
+        if last.to_bits() != cos_beta.to_bits() {
+            *last = cos_beta;
+            *value = cone.mean_clamped_cosine(cos_beta);
+        }
+        *value
+    }
 }
 
 impl<'a> Tracer<'a> {
@@ -198,12 +331,26 @@ impl<'a> Tracer<'a> {
         }
     }
 
-    /// Radiance along `ray` through `layers`, random numbers from `stream`.
-    pub fn trace(&self, ray: Ray, layers: Layers, stream: &mut SampleStream) -> PathRecord {
+    /// Radiance along `ray` through `layers`, random numbers from `stream`; `hints` speed up
+    /// the lights' shadow rays (keep one per thread; the result does not depend on it).
+    ///
+    /// `known` gives shadow answers the path takes instead of tracing at the camera ray's own
+    /// hit when that hit is of `known.primary`'s kind ([`KnownVisibility::NONE`]: none).
+    pub fn trace(
+        &self,
+        ray: Ray,
+        layers: Layers,
+        stream: &mut SampleStream,
+        hints: &mut ShadowHints,
+        known: &KnownVisibility,
+    ) -> PathRecord {
         let mut state = PathState {
             layers,
             touched_virtual: false,
             rays: 0,
+            hints,
+            known: LightVisibility::default(),
+            seen: LightVisibility::default(),
         };
         let mut radiance = Rgb::ZERO;
         let mut throughput = Rgb::ONE;
@@ -225,6 +372,11 @@ impl<'a> Tracer<'a> {
                 } else {
                     PrimaryHit::Real
                 };
+                if layers == Layers::WithObjects && known.primary == primary {
+                    state.known = known.lights;
+                }
+            } else {
+                state.known = LightVisibility::default();
             }
             if vertex >= self.bounces {
                 break;
@@ -312,6 +464,11 @@ impl<'a> Tracer<'a> {
             rays: state.rays,
             without_objects,
             new_light,
+            visibility: if vertex == 1 && layers == Layers::WithObjects {
+                state.seen
+            } else {
+                LightVisibility::default()
+            },
         }
     }
 
@@ -359,6 +516,20 @@ impl<'a> Tracer<'a> {
 
     /// Every light, each with its own shadow ray (all from one origin above the surface: a
     /// light below the geometric surface sends none).
+    ///
+    /// A hard light adds `f(w_o, l) cos(theta_l) I` where its ray along `l` is open. A soft light
+    /// (a cone of uniform radiance) splits its integral `int_cone f cos V L dw` into an analytic
+    /// unshadowed part and a sampled visibility (Heitz, Hill and McGuire 2018, "Combining
+    /// analytic direct illumination and stochastic shadows", whose ratio estimator this is for
+    /// one visibility sample per light and pixel sample): `f(w_o, l) I mean_cone(max(0, n . w))`
+    /// ([`UniformCone::mean_clamped_cosine`], exact where the cone is cut by the horizon) times
+    /// `V` along one cone point `w_s`. For a diffuse surface the expectation differs from
+    /// `int f cos V L` only by the correlation of `cos` and `V` inside one cone (a penumbra);
+    /// a glossy lobe is read at the axis ([`cone_bsdf`]). Unlike `f(w_s) cos(w_s)` per sample,
+    /// the shading is then the same in every sample, so a pixel's samples differ only where a
+    /// cone is partly blocked, which is what adaptive antialiasing ([`crate::adaptive`]) looks
+    /// for. A cone point below the geometric surface tells nothing about the light above it:
+    /// its mirror image above the surface stands in for it.
     fn lights(
         &self,
         list: &LightList,
@@ -368,10 +539,46 @@ impl<'a> Tracer<'a> {
         mut sum: LayeredLight,
     ) -> LayeredLight {
         let origin = above(vertex.surface);
-        for light in &list.lights {
-            let wi = light_direction(list.shadows, light, stream);
-            if let Some(f_cos) = reflection(vertex.surface, vertex.bsdf, vertex.wo, wi) {
-                sum.add(self.occlusion(origin, wi, state), f_cos * light.irradiance);
+        let surface = vertex.surface;
+        for (index, light) in list.lights.iter().enumerate() {
+            match (list.shadows, light.cone) {
+                (ShadowKind::Soft, Some(cone)) => {
+                    let axis = light.direction;
+                    let cos_beta = surface.shading_normal.dot(axis);
+                    let mean_cos = state.hints.mean_cos(index, cone, cos_beta);
+                    let f = cone_bsdf(vertex, axis, cos_beta);
+                    if mean_cos <= 0.0 || f.max_channel() <= 0.0 {
+                        stream.skip_2d();
+                        continue;
+                    }
+                    let light_value = f * (light.irradiance * mean_cos);
+                    if let Some(occlusion) = state.known.occlusion(index) {
+                        // Known from the neighbourhood: its cone point is not needed.
+                        stream.skip_2d();
+                        sum.add(self.known_occlusion(index, occlusion, state), light_value);
+                        continue;
+                    }
+                    let [u1, u2] = stream.next_2d();
+                    // A cone point below the geometric surface (a cone cut by the horizon) is
+                    // mirrored above it: the ray then samples the visible part's side of the
+                    // cone, whose light the clamped cosine already counts.
+                    let point = light.frame.to_world(cone.sample(u1, u2));
+                    let g = surface.geometric_normal;
+                    let below = g.dot(point);
+                    let wi = if below > 0.0 {
+                        point
+                    } else {
+                        (point - 2.0 * below * g).normalize_or(g)
+                    };
+                    sum.add(self.light_occlusion(origin, wi, index, state), light_value);
+                }
+                _ => {
+                    let wi = light.direction;
+                    if let Some(f_cos) = reflection(surface, vertex.bsdf, vertex.wo, wi) {
+                        let occlusion = self.light_occlusion(origin, wi, index, state);
+                        sum.add(occlusion, f_cos * light.irradiance);
+                    }
+                }
             }
         }
         sum
@@ -414,32 +621,46 @@ impl<'a> Tracer<'a> {
         sum
     }
 
-    /// The hybrid ambient: `albedo * mean_k V(w_k) L_a(w_k)` over cosine-distributed `w_k`.
+    /// The hybrid ambient, `albedo E[V(w) L_a(w)]` over cosine-distributed `w`, with the
+    /// unoccluded part exact: `albedo (E_a(n) / pi - mean_k (1 - V(w_k)) L_a(w_k))`, `E_a` the
+    /// ambient's SH irradiance ([`Ambient::irradiance`]), since `E[L_a(w)] = E_a(n) / pi` under
+    /// the cosine density. The same expectation as `mean_k V(w_k) L_a(w_k)` (a control
+    /// variate), but where no occlusion ray is blocked there is no noise at all, and only the
+    /// blocked rays evaluate `L_a`. A direction below the geometric surface is blocked by it.
     fn ambient(
         &self,
         ambient: &Ambient,
         surface: &SurfacePoint,
         stream: &mut SampleStream,
         state: &mut PathState,
-        mut sum: LayeredLight,
+        none: LayeredLight,
     ) -> LayeredLight {
         let albedo = surface.material.diffuse_albedo();
         if albedo.max_channel() <= 0.0 {
-            return sum;
+            return none;
         }
         let basis = OrthonormalBasis::from_normal(surface.shading_normal);
         let origin = above(surface);
+        // The ambient light the rays find blocked, in each layer.
+        let mut hidden = none;
         for _ in 0..ambient.occlusion_rays {
             let [u1, u2] = stream.next_2d();
             let wi = basis.to_world(sample_cosine_hemisphere(u1, u2));
-            if surface.geometric_normal.dot(wi) > 0.0 {
-                sum.add(self.occlusion(origin, wi, state), ambient.radiance(wi));
+            let occlusion = if surface.geometric_normal.dot(wi) > 0.0 {
+                self.occlusion(origin, wi, state)
+            } else {
+                Occlusion::Real
+            };
+            if occlusion != Occlusion::Open {
+                hidden.add_blocked(occlusion, ambient.radiance(wi));
             }
         }
-        let scale = |sum: Rgb| albedo * sum / ambient.occlusion_rays as f32;
+        let open = ambient.irradiance(surface.shading_normal) * std::f32::consts::FRAC_1_PI;
+        let k = ambient.occlusion_rays as f32;
+        let light = |hidden: Rgb| albedo * (open - hidden / k);
         LayeredLight {
-            with: scale(sum.with),
-            without: sum.without.map(scale),
+            with: light(hidden.with),
+            without: hidden.without.map(light),
         }
     }
 
@@ -465,6 +686,70 @@ impl<'a> Tracer<'a> {
     /// to infinity: the lights and the environment are distant.
     fn occlusion(&self, origin: Vec3, wi: Vec3, state: &mut PathState) -> Occlusion {
         self.occlusion_within(origin, wi, f32::INFINITY, state)
+    }
+
+    /// [`Tracer::occlusion`] for a ray towards light `index` of the light list: the known answer
+    /// where there is one, else traced with each layer's blocker of that light's previous ray
+    /// tested first; recorded in the path's visibility.
+    fn light_occlusion(
+        &self,
+        origin: Vec3,
+        wi: Vec3,
+        index: usize,
+        state: &mut PathState,
+    ) -> Occlusion {
+        if let Some(occlusion) = state.known.occlusion(index) {
+            return self.known_occlusion(index, occlusion, state);
+        }
+        let occlusion = self.traced_light_occlusion(origin, wi, index, state);
+        state.seen.record(index, occlusion);
+        occlusion
+    }
+
+    /// Takes `occlusion`, known for light `index` without tracing, as its shadow ray's answer.
+    fn known_occlusion(
+        &self,
+        index: usize,
+        occlusion: Occlusion,
+        state: &mut PathState,
+    ) -> Occlusion {
+        if occlusion == Occlusion::Virtual {
+            state.touched_virtual = true;
+        }
+        state.seen.record(index, occlusion);
+        occlusion
+    }
+
+    /// The shadow ray of [`Tracer::light_occlusion`], traced.
+    fn traced_light_occlusion(
+        &self,
+        origin: Vec3,
+        wi: Vec3,
+        index: usize,
+        state: &mut PathState,
+    ) -> Occlusion {
+        state.rays += 1;
+        let ray = Ray::new(origin, wi);
+        let [real, virtual_layer] = state.hints.light(index);
+        if self
+            .scene
+            .real
+            .bvh
+            .occluded_by(&ray, 0.0, f32::INFINITY, real)
+        {
+            return Occlusion::Real;
+        }
+        if state.layers == Layers::WithObjects
+            && self
+                .scene
+                .virtual_objects
+                .bvh
+                .occluded_by(&ray, 0.0, f32::INFINITY, virtual_layer)
+        {
+            state.touched_virtual = true;
+            return Occlusion::Virtual;
+        }
+        Occlusion::Open
     }
 
     /// What blocks the segment from `origin` along the unit `wi` to distance `t_max` (a point
@@ -503,26 +788,33 @@ fn reflection(surface: &SurfacePoint, bsdf: &Bsdf, wo: Vec3, wi: Vec3) -> Option
     (f.max_channel() > 0.0).then(|| f * cos)
 }
 
+/// How far above the shading horizon [`cone_bsdf`] reads a lobe whose cone axis is below it
+/// (the cosine of the direction it reads to the normal).
+const HORIZON_LIFT: f32 = 0.05;
+
+/// The BSDF a soft light's cone about `axis` (at `cos_beta` to the shading normal) is shaded
+/// with: at the axis, or, when the axis is below the horizon while part of the cone is above,
+/// just above the horizon towards the light (a diffuse lobe is the same everywhere above; the
+/// part of the cone below adds nothing, through the cone's clamped cosine).
+fn cone_bsdf(vertex: &Vertex, axis: Vec3, cos_beta: f32) -> Rgb {
+    let f = vertex.bsdf.eval(vertex.wo, axis);
+    if f.max_channel() > 0.0 {
+        return f;
+    }
+    let n = vertex.surface.shading_normal;
+    let lifted = (axis + n * (HORIZON_LIFT - cos_beta)).normalize_or(n);
+    let f = vertex.bsdf.eval(vertex.wo, lifted);
+    if f.max_channel() > 0.0 {
+        f
+    } else {
+        vertex.bsdf.eval(vertex.wo, n)
+    }
+}
+
 /// The origin of every ray that leaves `surface` on its geometric normal's side (shadow and
 /// occlusion rays, which are only traced there): [`offset_origin`] along that normal.
 fn above(surface: &SurfacePoint) -> Vec3 {
     offset_origin(surface, surface.geometric_normal)
-}
-
-/// The direction a light's shadow ray takes: its own (hard, or a point light) or a point of its
-/// cone from the stream's next pair (soft).
-fn light_direction(
-    shadows: ShadowKind,
-    light: &DirectionalLight,
-    stream: &mut SampleStream,
-) -> Vec3 {
-    match (shadows, light.cone) {
-        (ShadowKind::Soft, Some(cone)) => {
-            let [u1, u2] = stream.next_2d();
-            light.frame.to_world(cone.sample(u1, u2))
-        }
-        _ => light.direction,
-    }
 }
 
 /// The origin of a ray leaving `surface` along `wi`: the hit point moved along the geometric

@@ -83,6 +83,7 @@ fn settings(composite: CompositeRule, bounces: u32) -> RenderSettings {
         bounces,
         seed: 1,
         sampler: SamplerKind::Sobol,
+        adaptive: None,
     }
 }
 

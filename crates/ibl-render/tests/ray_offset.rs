@@ -60,6 +60,7 @@ fn the_contact_shadow_does_not_depend_on_the_size_of_the_ground() {
         bounces: 1,
         seed: 3,
         sampler: SamplerKind::Sobol,
+        adaptive: None,
     };
     let mean_ground = |size: f32| {
         let scene = bunny_on_ground(size);

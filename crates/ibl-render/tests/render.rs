@@ -67,6 +67,7 @@ fn settings(spp: u32, bounces: u32, seed: u64, composite: CompositeRule) -> Rend
         bounces,
         seed,
         sampler: SamplerKind::Sobol,
+        adaptive: None,
     }
 }
 

@@ -215,6 +215,7 @@ fn settings(spp: u32, seed: u64) -> RenderSettings {
         bounces: 1,
         seed,
         sampler: SamplerKind::Sobol,
+        adaptive: None,
     }
 }
 

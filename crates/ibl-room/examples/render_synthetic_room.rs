@@ -71,6 +71,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             bounces: 64,
             seed,
             sampler: ibl_render::SamplerKind::Sobol,
+            adaptive: None,
         };
         let out = render(&scene, &lighting, &settings, &|done, total| {
             if done % 64 == 0 || done == total {

@@ -152,6 +152,7 @@ fn render_halves(
             bounces: 64,
             seed,
             sampler: SamplerKind::Sobol,
+            adaptive: None,
         };
         render(&scene, &lighting, &settings, &|_, _| ())
             .expect("render")

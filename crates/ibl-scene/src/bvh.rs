@@ -272,13 +272,24 @@ impl Bvh {
     /// Whether any triangle is hit (either face) with `t_min < t < t_max`; stops at the first
     /// hit found (shadow rays). No allocation.
     pub fn occluded(&self, ray: &Ray, t_min: f32, t_max: f32) -> bool {
+        let mut hint = OccluderHint::NONE;
+        self.occluded_by(ray, t_min, t_max, &mut hint)
+    }
+
+    /// [`Bvh::occluded`], testing the triangle of `hint` first: the one that blocked an earlier,
+    /// similar ray (a shadow cache: neighbouring shadow rays towards one light are mostly blocked
+    /// by the same triangle, and one triangle test replaces the walk down the tree). A ray the
+    /// tree finds blocked leaves its blocking triangle in `hint`; an open one leaves `hint` as
+    /// it was. The answer is the same whatever the hint: the hinted triangle is tested with the
+    /// same test and bounds as in the walk.
+    pub fn occluded_by(&self, ray: &Ray, t_min: f32, t_max: f32, hint: &mut OccluderHint) -> bool {
         if self.indices.is_empty() {
             return false;
         }
         match dominant_axis(ray.direction) {
-            0 => self.any::<1, 2, 0>(ray, t_min, t_max),
-            1 => self.any::<2, 0, 1>(ray, t_min, t_max),
-            _ => self.any::<0, 1, 2>(ray, t_min, t_max),
+            0 => self.any::<1, 2, 0>(ray, t_min, t_max, hint),
+            1 => self.any::<2, 0, 1>(ray, t_min, t_max, hint),
+            _ => self.any::<0, 1, 2>(ray, t_min, t_max, hint),
         }
     }
 
@@ -389,6 +400,7 @@ impl Bvh {
         ray: &Ray,
         t_min: f32,
         t_max: f32,
+        hint: &mut OccluderHint,
     ) -> bool {
         let box_ray = BoxRay::new(ray, t_min);
         let cull = widen(t_max);
@@ -405,11 +417,21 @@ impl Bvh {
                 .intersect(tri)
                 .is_some_and(|h| h.t > t_min && h.t < t_max)
         };
+        if let Some(tri) = self.triangles.get(hint.0 as usize)
+            && hits(tri)
+        {
+            return true;
+        }
+        // The first triangle of `first..first + count` that blocks, noted in the hint.
+        let mut blocked_in = |first: usize, count: usize| {
+            let found = self.triangles[first..first + count].iter().position(hits);
+            if let Some(k) = found {
+                hint.0 = (first + k) as u32;
+            }
+            found.is_some()
+        };
         if node.count > 0 {
-            let first = node.child as usize;
-            return self.triangles[first..first + node.count as usize]
-                .iter()
-                .any(hits);
+            return blocked_in(node.child as usize, node.count as usize);
         }
         let mut stack = [NodeRef::default(); STACK_SIZE];
         let mut sp = 0;
@@ -435,11 +457,7 @@ impl Bvh {
                 node = pair.get(first);
                 continue;
             }
-            let first = node.child as usize;
-            if self.triangles[first..first + node.count as usize]
-                .iter()
-                .any(hits)
-            {
+            if blocked_in(node.child as usize, node.count as usize) {
                 return true;
             }
             if sp == 0 {
@@ -448,6 +466,22 @@ impl Bvh {
             sp -= 1;
             node = stack[sp];
         }
+    }
+}
+
+/// The triangle that blocked an earlier shadow ray ([`Bvh::occluded_by`]): a position in one
+/// BVH's leaf order, meaningful for that BVH only.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct OccluderHint(u32);
+
+impl OccluderHint {
+    /// No triangle yet.
+    pub const NONE: OccluderHint = OccluderHint(u32::MAX);
+}
+
+impl Default for OccluderHint {
+    fn default() -> Self {
+        OccluderHint::NONE
     }
 }
 

@@ -72,6 +72,7 @@ fn compare_model(name: &str, model: SceneModel) -> Option<(Image<Rgb>, Image<Rgb
         bounces: 1,
         seed: 1,
         sampler: scene.render.sampler,
+        adaptive: None,
     };
     let cpu = render(scene, &lighting, &settings, &|_, _| {}).expect("cpu renders");
     let cpu_seconds = started.elapsed().as_secs_f64();

@@ -120,6 +120,7 @@ pub fn render_with_objects(
             bounces: 64,
             seed,
             sampler: SamplerKind::Sobol,
+            adaptive: None,
         };
         render(&scene, &lighting, &settings, &|_, _| ()).expect("render")
     })

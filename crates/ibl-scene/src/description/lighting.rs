@@ -33,6 +33,15 @@ pub struct LightingDescription {
     /// every light once, its soft-shadow cone stratified across the samples). Default 4.
     #[serde(default = "default_lights_spp")]
     pub spp: u32,
+    /// Adaptive antialiasing (Mitchell 1987): every pixel takes one sample first, and only
+    /// pixels whose 3 x 3 neighbourhood differs (a silhouette, a penumbra, a change of surface)
+    /// take the rest of `spp`. Default `true`; `false` gives every pixel all `spp` samples.
+    #[serde(default = "default_adaptive")]
+    pub adaptive: bool,
+    /// The contrast `(max - min) / (max + min)` over a pixel's neighbourhood, per channel, above
+    /// which an adaptive pixel takes all `spp` samples. Default 0.04, in `(0, 1]`.
+    #[serde(default = "default_adaptive_contrast")]
+    pub adaptive_contrast: f32,
     /// SH bands of the hybrid ambient. Default 3.
     #[serde(default = "default_bands")]
     pub ambient_bands: u32,
@@ -59,6 +68,12 @@ fn default_lights() -> u32 {
 fn default_lights_spp() -> u32 {
     4
 }
+fn default_adaptive() -> bool {
+    true
+}
+fn default_adaptive_contrast() -> f32 {
+    0.04
+}
 fn default_bands() -> u32 {
     3
 }
@@ -74,6 +89,8 @@ impl Default for LightingDescription {
             lights_file: None,
             shadows: ShadowKind::default(),
             spp: default_lights_spp(),
+            adaptive: default_adaptive(),
+            adaptive_contrast: default_adaptive_contrast(),
             ambient_bands: default_bands(),
             ao_samples: default_ao(),
         }
@@ -114,6 +131,12 @@ impl LightingDescription {
             return Err(invalid(
                 "lighting.spp",
                 format!("{} is not in 1..={MAX_SPP}", self.spp),
+            ));
+        }
+        if !(self.adaptive_contrast > 0.0 && self.adaptive_contrast <= 1.0) {
+            return Err(invalid(
+                "lighting.adaptive_contrast",
+                format!("{} is not in (0, 1]", self.adaptive_contrast),
             ));
         }
         if !(1..=16).contains(&self.ambient_bands) {
