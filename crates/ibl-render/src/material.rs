@@ -111,6 +111,19 @@ impl Bsdf {
         matches!(self.lobes, Lobes::Mirror { .. })
     }
 
+    /// `f = albedo / pi` when the BSDF is purely diffuse and `wo` is on the surface's side: then
+    /// `eval(wo, wi)` is that value for every `wi` above both the shading and the geometric
+    /// surface (and 0 below), so a caller lighting one point from many directions can read it
+    /// once. `None` for other lobes, or `wo` below the geometric surface.
+    pub fn lambertian(&self, wo: Vec3) -> Option<Rgb> {
+        match self.lobes {
+            Lobes::Diffuse { albedo } if wo.dot(self.geometric_normal) > 0.0 => {
+                Some(albedo * FRAC_1_PI)
+            }
+            _ => None,
+        }
+    }
+
     /// The mirror direction of `wo` about the shading normal.
     fn mirror(&self, wo: Vec3) -> Vec3 {
         let n = self.shading.normal;
@@ -263,6 +276,28 @@ mod tests {
         assert_eq!(bsdf.eval(wo, s.wi), Rgb::ZERO);
         assert_eq!(bsdf.pdf(wo, s.wi), 0.0);
         assert!(bsdf.is_delta());
+    }
+
+    #[test]
+    fn the_lambertian_value_is_eval_above_the_surface() {
+        let n_g = Vec3::Y;
+        let n_s = Vec3::new(0.3, 1.0, 0.0).normalize();
+        let albedo = Rgb::new(0.5, 0.6, 0.7);
+        let bsdf = Bsdf::new(&Material::Diffuse { albedo }, n_s, n_g);
+        let wo = Vec3::new(0.2, 1.0, 0.1).normalize();
+        let f = bsdf.lambertian(wo).expect("diffuse");
+        for wi in [Vec3::Y, Vec3::new(1.0, 0.2, 0.0), Vec3::new(-0.3, 0.5, 0.8)] {
+            assert_eq!(bsdf.eval(wo, wi.normalize()), f);
+        }
+        assert!(bsdf.lambertian(-wo).is_none());
+        let mirror = Bsdf::new(
+            &Material::Mirror {
+                reflectance: albedo,
+            },
+            n_s,
+            n_g,
+        );
+        assert!(mirror.lambertian(wo).is_none());
     }
 
     #[test]

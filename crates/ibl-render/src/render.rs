@@ -33,7 +33,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::RenderError;
-use crate::adaptive::{FirstSample, needs_refinement};
+use crate::adaptive::{CoarseGrid, FirstSample, needs_refinement};
 use crate::background::background_image;
 use crate::lighting::{Illumination, Lighting};
 use crate::sampler::{SOBOL_MAX_SAMPLES, SampleStream, SamplerKind};
@@ -208,14 +208,39 @@ pub fn render(
             })
             .collect(),
         Some(contrast) => {
-            // Pass 1: sample 0 of every pixel; pass 2: samples 1.. where the first samples of the
-            // pixel's neighbourhood differ (crate::adaptive).
+            // Pass 1: sample 0 of every pixel, the coarse grid's first (every light traced),
+            // then the pixels between, which take the lights their coarse neighbours agree on;
+            // pass 2: samples 1.. where the first samples of the pixel's neighbourhood differ
+            // (crate::adaptive).
+            let grid = CoarseGrid::new(w, h);
+            let (cw, ch) = grid.size();
+            let coarse: Vec<FirstSample> = (0..ch)
+                .into_par_iter()
+                .flat_map_iter(|j| {
+                    let mut hints = ShadowHints::default();
+                    let row: Vec<FirstSample> = (0..cw)
+                        .map(|i| {
+                            let known = &KnownVisibility::NONE;
+                            let pixel = sampler.first_sample(2 * i, 2 * j, &mut hints, known);
+                            pixel.first_sample()
+                        })
+                        .collect();
+                    row
+                })
+                .collect();
             let mut sums: Vec<PixelSums> = (0..h)
                 .into_par_iter()
                 .flat_map_iter(|y| {
                     let mut hints = ShadowHints::default();
                     let row: Vec<PixelSums> = (0..w)
-                        .map(|x| sampler.samples(x, y, 0..1, &mut hints))
+                        .map(|x| {
+                            let known = if CoarseGrid::is_coarse(x, y) {
+                                KnownVisibility::NONE
+                            } else {
+                                grid.known(&coarse, x, y)
+                            };
+                            sampler.first_sample(x, y, &mut hints, &known)
+                        })
                         .collect();
                     row_done();
                     row
@@ -352,6 +377,19 @@ impl PixelSampler<'_> {
     ) -> PixelSums {
         let mut sums = PixelSums::default();
         self.add_samples(&mut sums, x, y, samples, hints, &KnownVisibility::NONE);
+        sums
+    }
+
+    /// The sums of sample 0 of pixel `(x, y)`, taking the shadow answers `known`.
+    fn first_sample(
+        &self,
+        x: usize,
+        y: usize,
+        hints: &mut ShadowHints,
+        known: &KnownVisibility,
+    ) -> PixelSums {
+        let mut sums = PixelSums::default();
+        self.add_samples(&mut sums, x, y, 0..1, hints, known);
         sums
     }
 

@@ -58,7 +58,7 @@ use ibl_scene::{Hit, Ray, Scene, ShadowKind, SurfacePoint};
 use crate::lighting::{Ambient, Illumination, LightList, Lighting};
 use crate::material::Bsdf;
 use crate::sampler::SampleStream;
-use crate::sampling::{OrthonormalBasis, UniformCone, power_heuristic, sample_cosine_hemisphere};
+use crate::sampling::{ConeShading, OrthonormalBasis, power_heuristic, sample_cosine_hemisphere};
 
 /// Which layers a path may meet.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -191,6 +191,8 @@ struct Vertex<'a> {
     bsdf: &'a Bsdf,
     /// Unit direction towards the camera (the previous vertex).
     wo: Vec3,
+    /// The BSDF's one value when it is diffuse ([`Bsdf::lambertian`]), read once per vertex.
+    lambertian: Option<Rgb>,
 }
 
 /// Light arriving at a vertex, with the objects and (when the walk can tell) without them.
@@ -198,6 +200,32 @@ struct Vertex<'a> {
 struct LayeredLight {
     with: Rgb,
     without: Option<Rgb>,
+}
+
+impl<'a> Vertex<'a> {
+    fn new(surface: &'a SurfacePoint, bsdf: &'a Bsdf, wo: Vec3) -> Vertex<'a> {
+        Vertex {
+            surface,
+            bsdf,
+            wo,
+            lambertian: bsdf.lambertian(wo),
+        }
+    }
+
+    /// `f(wo, wi) cos(theta_i)` for light arriving from `wi`, or `None` when the surface cannot
+    /// reflect it (below the shading or geometric surface, or a zero BSDF).
+    #[inline]
+    fn reflection(&self, wi: Vec3) -> Option<Rgb> {
+        let surface = self.surface;
+        let cos = surface.shading_normal.dot(wi);
+        if cos <= 0.0 || surface.geometric_normal.dot(wi) <= 0.0 {
+            return None;
+        }
+        let f = self
+            .lambertian
+            .unwrap_or_else(|| self.bsdf.eval(self.wo, wi));
+        (f.max_channel() > 0.0).then(|| f * cos)
+    }
 }
 
 impl LayeredLight {
@@ -218,6 +246,15 @@ impl LayeredLight {
     fn add_new(&mut self, occlusion: Occlusion, value: Rgb) {
         if occlusion == Occlusion::Open {
             self.with += value;
+        }
+    }
+
+    /// Adds `value` to every layer.
+    #[inline]
+    fn add_all(&mut self, value: Rgb) {
+        self.with += value;
+        if let Some(without) = &mut self.without {
+            *without += value;
         }
     }
 
@@ -264,6 +301,8 @@ pub struct Tracer<'a> {
     scene: &'a Scene,
     lighting: &'a Lighting,
     bounces: u32,
+    /// Per light of the lighting's light list, its cone's shading table (soft lights).
+    cone_shading: Vec<Option<ConeShading>>,
 }
 
 /// Vertex count from which Russian roulette may end a path.
@@ -285,15 +324,10 @@ struct PathState<'h> {
 /// ([`ibl_scene::bvh::Bvh::occluded_by`]): kept by the caller across the samples and pixels one
 /// thread traces, so that a shadow's neighbouring rays test their likely blocker first. Only a
 /// speed-up: every answer is the same with any hints.
-///
-/// It also keeps each soft light's last cone cosine ([`UniformCone::mean_clamped_cosine`]),
-/// which a flat surface asks for again and again with the same normal.
 #[derive(Clone, Debug, Default)]
 pub struct ShadowHints {
     /// `[real, virtual]` per light of the light list.
     lights: Vec<[OccluderHint; 2]>,
-    /// Per light, the last `(cos_beta, mean_clamped_cosine(cos_beta))`.
-    mean_cos: Vec<(f32, f32)>,
 }
 
 impl ShadowHints {
@@ -304,30 +338,25 @@ impl ShadowHints {
         }
         &mut self.lights[index]
     }
-
-    /// `cone.mean_clamped_cosine(cos_beta)` for light `index` (whose cone is `cone`), computed
-    /// only when `cos_beta` differs from the light's last one: bit for bit the same value.
-    fn mean_cos(&mut self, index: usize, cone: UniformCone, cos_beta: f32) -> f32 {
-        if index >= self.mean_cos.len() {
-            self.mean_cos.resize(index + 1, (f32::NAN, 0.0));
-        }
-        let (last, value) = &mut self.mean_cos[index];
-        if last.to_bits() != cos_beta.to_bits() {
-            *last = cos_beta;
-            *value = cone.mean_clamped_cosine(cos_beta);
-        }
-        *value
-    }
 }
 
 impl<'a> Tracer<'a> {
     /// A tracer for `scene` lit by `lighting`, paths of at most `bounces` surface vertices (the
     /// lights and hybrid modes end at the first diffuse or glossy one).
     pub fn new(scene: &'a Scene, lighting: &'a Lighting, bounces: u32) -> Tracer<'a> {
+        let cone_shading = match &lighting.illumination {
+            Illumination::Lights(list) | Illumination::Hybrid(list, _) => list
+                .lights
+                .iter()
+                .map(|l| l.cone.map(ConeShading::new))
+                .collect(),
+            Illumination::Environment => Vec::new(),
+        };
         Tracer {
             scene,
             lighting,
             bounces: bounces.max(1),
+            cone_shading,
         }
     }
 
@@ -391,25 +420,17 @@ impl<'a> Tracer<'a> {
             if !bsdf.is_delta() {
                 match &self.lighting.illumination {
                     Illumination::Environment => {
-                        let vertex = Vertex {
-                            surface: &surface,
-                            bsdf: &bsdf,
-                            wo,
-                        };
+                        let vertex = Vertex::new(&surface, &bsdf, wo);
                         let none = LayeredLight::none(&state);
                         let luminaires = self.luminaires(&vertex, &mut state, none);
                         new_light += throughput * luminaires.with;
                         radiance += throughput
-                            * (self.environment_sample(&surface, &bsdf, wo, stream, &mut state)
+                            * (self.environment_sample(&vertex, stream, &mut state)
                                 + luminaires.with);
                     }
                     Illumination::Lights(list) => {
                         let none = LayeredLight::none(&state);
-                        let vertex = Vertex {
-                            surface: &surface,
-                            bsdf: &bsdf,
-                            wo,
-                        };
+                        let vertex = Vertex::new(&surface, &bsdf, wo);
                         let lamps = self.luminaires(&vertex, &mut state, none);
                         new_light += throughput * lamps.with;
                         let direct = self.lights(list, &vertex, stream, &mut state, none) + lamps;
@@ -421,11 +442,7 @@ impl<'a> Tracer<'a> {
                     }
                     Illumination::Hybrid(list, ambient) => {
                         let none = LayeredLight::none(&state);
-                        let vertex = Vertex {
-                            surface: &surface,
-                            bsdf: &bsdf,
-                            wo,
-                        };
+                        let vertex = Vertex::new(&surface, &bsdf, wo);
                         let lamps = self.luminaires(&vertex, &mut state, none);
                         new_light += throughput * lamps.with;
                         let direct = self.lights(list, &vertex, stream, &mut state, none)
@@ -491,9 +508,7 @@ impl<'a> Tracer<'a> {
     /// One environment sample, MIS-weighted against BSDF sampling.
     fn environment_sample(
         &self,
-        surface: &SurfacePoint,
-        bsdf: &Bsdf,
-        wo: Vec3,
+        vertex: &Vertex,
         stream: &mut SampleStream,
         state: &mut PathState,
     ) -> Rgb {
@@ -504,13 +519,13 @@ impl<'a> Tracer<'a> {
         if sample.pdf_sr <= 0.0 {
             return Rgb::ZERO;
         }
-        let Some(f_cos) = reflection(surface, bsdf, wo, wi) else {
+        let Some(f_cos) = vertex.reflection(wi) else {
             return Rgb::ZERO;
         };
-        if self.occlusion(above(surface), wi, state) != Occlusion::Open {
+        if self.occlusion(above(vertex.surface), wi, state) != Occlusion::Open {
             return Rgb::ZERO;
         }
-        let weight = power_heuristic(sample.pdf_sr, bsdf.pdf(wo, wi));
+        let weight = power_heuristic(sample.pdf_sr, vertex.bsdf.pdf(vertex.wo, wi));
         f_cos * sample.radiance * (weight / sample.pdf_sr)
     }
 
@@ -518,18 +533,18 @@ impl<'a> Tracer<'a> {
     /// light below the geometric surface sends none).
     ///
     /// A hard light adds `f(w_o, l) cos(theta_l) I` where its ray along `l` is open. A soft light
-    /// (a cone of uniform radiance) splits its integral `int_cone f cos V L dw` into an analytic
-    /// unshadowed part and a sampled visibility (Heitz, Hill and McGuire 2018, "Combining
-    /// analytic direct illumination and stochastic shadows", whose ratio estimator this is for
-    /// one visibility sample per light and pixel sample): `f(w_o, l) I mean_cone(max(0, n . w))`
-    /// ([`UniformCone::mean_clamped_cosine`], exact where the cone is cut by the horizon) times
-    /// `V` along one cone point `w_s`. For a diffuse surface the expectation differs from
-    /// `int f cos V L` only by the correlation of `cos` and `V` inside one cone (a penumbra);
-    /// a glossy lobe is read at the axis ([`cone_bsdf`]). Unlike `f(w_s) cos(w_s)` per sample,
-    /// the shading is then the same in every sample, so a pixel's samples differ only where a
-    /// cone is partly blocked, which is what adaptive antialiasing ([`crate::adaptive`]) looks
-    /// for. A cone point below the geometric surface tells nothing about the light above it:
-    /// its mirror image above the surface stands in for it.
+    /// (a cone of uniform radiance `L`, `I = L A`) adds `f I (mean_cone(max(0, n . w)) - c_s
+    /// (1 - V(w_s)))`: its unshadowed light exact ([`crate::sampling::UniformCone::
+    /// mean_clamped_cosine`], through [`ConeShading`], also where the horizon cuts the cone),
+    /// less what the cone point `w_s` (uniform in the cone) finds blocked, `c_s = max(0, n .
+    /// w_s)`. Since `E[c_s] = mean_cone(max(0, n . w))` this is a control variate: its
+    /// expectation is the cone's shadowed light `f L int_cone max(0, n . w) V(w) dw` (for a
+    /// diffuse surface exactly; a glossy lobe is read at the axis, [`cone_bsdf`]), the same as
+    /// `f I c_s V(w_s)` per point, but where the ray is open it is the exact unshadowed value,
+    /// the same in every sample, so a pixel's samples differ only where a cone is partly or
+    /// wholly hidden, which is what adaptive antialiasing ([`crate::adaptive`]) looks for. A
+    /// cone point below the shading surface adds nothing (`c_s = 0`) and sends no ray; one above
+    /// it but below the geometric surface is blocked by the surface itself.
     fn lights(
         &self,
         list: &LightList,
@@ -545,36 +560,48 @@ impl<'a> Tracer<'a> {
                 (ShadowKind::Soft, Some(cone)) => {
                     let axis = light.direction;
                     let cos_beta = surface.shading_normal.dot(axis);
-                    let mean_cos = state.hints.mean_cos(index, cone, cos_beta);
+                    let mean_cos = match &self.cone_shading.get(index) {
+                        Some(Some(table)) => table.mean_clamped_cosine(cos_beta),
+                        _ => cone.mean_clamped_cosine(cos_beta),
+                    };
                     let f = cone_bsdf(vertex, axis, cos_beta);
                     if mean_cos <= 0.0 || f.max_channel() <= 0.0 {
                         stream.skip_2d();
                         continue;
                     }
-                    let light_value = f * (light.irradiance * mean_cos);
-                    if let Some(occlusion) = state.known.occlusion(index) {
-                        // Known from the neighbourhood: its cone point is not needed.
+                    // The unshadowed cone, exact, in every layer; then what the cone point's
+                    // ray finds blocked is taken off where it is blocked.
+                    let light_value = f * light.irradiance;
+                    sum.add_all(light_value * mean_cos);
+                    let known = state.known.occlusion(index);
+                    if known == Some(Occlusion::Open) {
+                        // Known open from the neighbourhood: nothing to take off, no point needed.
                         stream.skip_2d();
-                        sum.add(self.known_occlusion(index, occlusion, state), light_value);
+                        self.known_occlusion(index, Occlusion::Open, state);
                         continue;
                     }
                     let [u1, u2] = stream.next_2d();
-                    // A cone point below the geometric surface (a cone cut by the horizon) is
-                    // mirrored above it: the ray then samples the visible part's side of the
-                    // cone, whose light the clamped cosine already counts.
                     let point = light.frame.to_world(cone.sample(u1, u2));
-                    let g = surface.geometric_normal;
-                    let below = g.dot(point);
-                    let wi = if below > 0.0 {
-                        point
+                    let cos = surface.shading_normal.dot(point);
+                    if cos <= 0.0 {
+                        // Below the shading surface the cone adds nothing: nothing to take off.
+                        continue;
+                    }
+                    let occlusion = if surface.geometric_normal.dot(point) <= 0.0 {
+                        // Above the shading surface but below the geometric one: the surface
+                        // itself hides it (as in `Vertex::reflection`), in every layer.
+                        Occlusion::Real
                     } else {
-                        (point - 2.0 * below * g).normalize_or(g)
+                        match known {
+                            Some(occlusion) => self.known_occlusion(index, occlusion, state),
+                            None => self.light_occlusion(origin, point, index, state),
+                        }
                     };
-                    sum.add(self.light_occlusion(origin, wi, index, state), light_value);
+                    sum.add_blocked(occlusion, light_value * -cos);
                 }
                 _ => {
                     let wi = light.direction;
-                    if let Some(f_cos) = reflection(surface, vertex.bsdf, vertex.wo, wi) {
+                    if let Some(f_cos) = vertex.reflection(wi) {
                         let occlusion = self.light_occlusion(origin, wi, index, state);
                         sum.add(occlusion, f_cos * light.irradiance);
                     }
@@ -608,7 +635,7 @@ impl<'a> Tracer<'a> {
             }
             let distance = d2.sqrt();
             let wi = to_light / distance;
-            let Some(f_cos) = reflection(vertex.surface, vertex.bsdf, vertex.wo, wi) else {
+            let Some(f_cos) = vertex.reflection(wi) else {
                 continue;
             };
             let intensity = light.intensity_towards(-wi);
@@ -776,18 +803,6 @@ impl<'a> Tracer<'a> {
     }
 }
 
-/// `f(wo, wi) cos(theta_i)` for light arriving from `wi`, or `None` when the surface cannot
-/// reflect it (below the shading or geometric surface, or a zero BSDF).
-#[inline]
-fn reflection(surface: &SurfacePoint, bsdf: &Bsdf, wo: Vec3, wi: Vec3) -> Option<Rgb> {
-    let cos = surface.shading_normal.dot(wi);
-    if cos <= 0.0 || surface.geometric_normal.dot(wi) <= 0.0 {
-        return None;
-    }
-    let f = bsdf.eval(wo, wi);
-    (f.max_channel() > 0.0).then(|| f * cos)
-}
-
 /// How far above the shading horizon [`cone_bsdf`] reads a lobe whose cone axis is below it
 /// (the cosine of the direction it reads to the normal).
 const HORIZON_LIFT: f32 = 0.05;
@@ -797,6 +812,9 @@ const HORIZON_LIFT: f32 = 0.05;
 /// just above the horizon towards the light (a diffuse lobe is the same everywhere above; the
 /// part of the cone below adds nothing, through the cone's clamped cosine).
 fn cone_bsdf(vertex: &Vertex, axis: Vec3, cos_beta: f32) -> Rgb {
+    if let Some(f) = vertex.lambertian {
+        return f;
+    }
     let f = vertex.bsdf.eval(vertex.wo, axis);
     if f.max_channel() > 0.0 {
         return f;

@@ -402,13 +402,16 @@ impl Bvh {
         t_max: f32,
         hint: &mut OccluderHint,
     ) -> bool {
-        let box_ray = BoxRay::new(ray, t_min);
         let cull = widen(t_max);
         let mut node = self.root;
         // Early outs before the triangle ray and the traversal stack (zeroed, 512 bytes) are
         // made: most shadow rays miss both of the root's children (the rays from a floor past a
-        // small object), and a root leaf (a ground plane's two triangles) is tested directly.
-        if node.count == 0 && box_ray.test(&self.pairs[node.child as usize], cull).0 == 0 {
+        // small object), and a root leaf (a ground plane's two triangles) is tested directly,
+        // without the box ray's divisions.
+        let box_ray = (node.count == 0).then(|| BoxRay::new(ray, t_min));
+        if let Some(box_ray) = &box_ray
+            && box_ray.test(&self.pairs[node.child as usize], cull).0 == 0
+        {
             return false;
         }
         let tri_ray = TriangleRay::<KX, KY, KZ>::new(ray);
@@ -430,9 +433,9 @@ impl Bvh {
             }
             found.is_some()
         };
-        if node.count > 0 {
+        let Some(box_ray) = box_ray else {
             return blocked_in(node.child as usize, node.count as usize);
-        }
+        };
         let mut stack = [NodeRef::default(); STACK_SIZE];
         let mut sp = 0;
         loop {
