@@ -10,25 +10,31 @@
 //! samples ([`FirstSample`]) shows
 //!
 //! - a change of what the camera met (background, real surface, virtual object): a silhouette;
-//! - a contrast `(max - min) / (max + min)` above the threshold `c` in any channel of the radiance
-//!   with the objects or without them: a penumbra (a shadow ray open in one sample and blocked
-//!   in its neighbour's), a shading edge, a change of material.
+//! - a first sample that differs from the mean of its (up to eight) neighbours' by more than
+//!   `c (value + mean)` in any channel of the radiance with the objects or without them: a
+//!   penumbra (a shadow ray open in one sample and blocked in its neighbour's), a shading edge,
+//!   a change of material.
+//!
+//! The test is Mitchell's with the neighbourhood's mean in place of its extremes: a pixel on a
+//! smooth gradient (a floor lit at a slant, the bunny's flank) equals the mean of its
+//! neighbours and keeps one sample, where `(max - min) / (max + min)` over the neighbourhood
+//! refined it for a change spread over three pixels. Mitchell's thresholds were 0.4, 0.3 and
+//! 0.6 for 8-bit display values; the renders here are linear HDR composited into a photograph,
+//! so the default is far stricter (0.02, `[lighting] adaptive_contrast`). The decision depends
+//! only on first samples, which depend on the seed only, so the image stays independent of the
+//! thread count. The reference mode is never adaptive: it is the unbiased judge of the others.
 //!
 //! A refined pixel's later samples trace only the shadow rays that can change (Whitted 1980
 //! section 4 on adaptive supersampling, where only the rays between differing samples are
-//! cast; here per light): where all nine first samples met one kind of surface and found a
-//! light's shadow ray blocked the same way (open, blocked by the real layer, or by the objects
+//! cast; here per light): where all the first samples around that met one kind of surface found
+//! a light's shadow ray blocked the same way (open, blocked by the real layer, or by the objects
 //! only), the later samples take that answer for that light ([`KnownVisibility`]) and trace the
-//! others: the lights whose shadow edge passes through the neighbourhood. A shadow edge thinner
-//! than the first samples' spacing, or a later sample meeting another kind of surface (which
-//! then traces everything), is what this can miss. A pixel left at one sample is its own
-//! sample 0, which for a smooth neighbourhood differs from the pixel's mean by less than the
-//! contrast the test allows.
-//! Mitchell's per-channel thresholds were 0.4, 0.3 and 0.6 for 8-bit display values; the renders
-//! here are linear HDR composited into a photograph, so the default is far stricter (0.04,
-//! `[lighting] adaptive_contrast`). The decision depends only on first samples, which depend on
-//! the seed only, so the image stays independent of the thread count. The reference mode is
-//! never adaptive: it is the unbiased judge of the others.
+//! others: the lights whose shadow edge passes through the neighbourhood. Each kind of surface
+//! lends its own answers (across a silhouette too), and only for a light that at least four of
+//! its samples traced (a cone point below the surface traces nothing and says nothing). A shadow edge
+//! thinner than the first samples' spacing is what this can miss. A pixel left at one sample is
+//! its own sample 0, which for a smooth neighbourhood differs from the pixel's mean by less than
+//! the deviation the test allows.
 //!
 //! The first pass itself runs on a coarse grid first ([`CoarseGrid`]): pixels with even `x` and
 //! `y` trace every light, and the others take the answers of the lights their coarse neighbours
@@ -57,9 +63,10 @@ pub struct FirstSample {
 
 /// Whether the pixel at `(x, y)` of a `width x height` grid of first samples (row-major) needs
 /// all its samples: its 3 x 3 neighbourhood (clipped at the image's border) holds more than one
-/// kind of primary hit, or a contrast above `contrast` in a channel of `with` or `without`.
-/// `Some` with what its later samples may take instead of tracing (nothing across a
-/// silhouette), `None` when its first sample is enough.
+/// kind of primary hit, or its own `with` or `without` deviates from its neighbours' mean by
+/// more than `contrast (value + mean)` in a channel.
+/// `Some` with what its later samples may take instead of tracing (per kind of surface, from
+/// the neighbours of that kind), `None` when its first sample is enough.
 pub fn needs_refinement(
     first: &[FirstSample],
     width: usize,
@@ -68,24 +75,39 @@ pub fn needs_refinement(
     y: usize,
     contrast: f32,
 ) -> Option<KnownVisibility> {
-    let mut agreement = Agreement::new(first[y * width + x]);
+    let centre = first[y * width + x];
+    let mut agreement = Agreement::new(centre);
+    let (mut with, mut without, mut others) = (Rgb::ZERO, Rgb::ZERO, 0u32);
     for ny in y.saturating_sub(1)..(y + 2).min(height) {
         for nx in x.saturating_sub(1)..(x + 2).min(width) {
-            agreement.add(first[ny * width + nx]);
+            let s = first[ny * width + nx];
+            agreement.add(s);
+            if (nx, ny) != (x, y) {
+                with += s.with;
+                without += s.without;
+                others += 1;
+            }
         }
     }
-    if agreement.silhouette {
-        return Some(KnownVisibility::NONE);
-    }
-    if !(agreement.with.exceeds(contrast) || agreement.without.exceeds(contrast)) {
+    let n = others.max(1) as f32;
+    if !agreement.silhouette
+        && !deviates(centre.with, with / n, contrast)
+        && !deviates(centre.without, without / n, contrast)
+    {
         return None;
     }
     Some(agreement.known())
 }
 
+/// Whether `value` differs from `mean` by more than `contrast (value + mean)` in a channel.
+fn deviates(value: Rgb, mean: Rgb, contrast: f32) -> bool {
+    let over = |v: f32, m: f32| (v - m).abs() > contrast * (v + m);
+    over(value.r, mean.r) || over(value.g, mean.g) || over(value.b, mean.b)
+}
+
 /// The first pass's coarse grid: pixels with even `x` and `y` trace every light; the others
 /// take, for each light, the answer that all coarse pixels within [`REACH`] pixels in `x` and
-/// in `y` found (3 x 3 to 4 x 4 of them), when those all met one kind of surface
+/// in `y` (3 x 3 to 4 x 4 of them) that met the same kind of surface found
 /// ([`KnownVisibility`]), and trace the rest. Nine or more agreeing samples keep a soft
 /// shadow's random first samples from agreeing by chance (with two, a cone half hidden agrees
 /// a quarter of the time); shadow edges are traced at full resolution, and only a shadow
@@ -133,107 +155,108 @@ impl CoarseGrid {
                 agreement.add(coarse[j * self.width + i]);
             }
         }
-        if agreement.silhouette {
-            KnownVisibility::NONE
-        } else {
-            agreement.known()
-        }
+        agreement.known()
     }
 }
 
 /// How far, in image pixels, [`CoarseGrid::known`] looks for coarse pixels.
 const REACH: usize = 3;
 
-/// What a set of first samples agree on: one kind of primary hit or not, the range of their
-/// light, and per light whether each traced it and found it blocked the same way.
+/// What a set of first samples agree on: one kind of primary hit or not, and per kind of surface, per light, whether each sample of that kind traced it and
+/// found it blocked the same way.
 struct Agreement {
     primary: PrimaryHit,
     silhouette: bool,
-    with: Range,
-    without: Range,
-    /// Traced by every sample.
-    tested: u64,
-    /// Blocked by the real layer in every sample, in some sample.
+    /// Real surfaces, virtual objects.
+    kinds: [KindAgreement; 2],
+}
+
+/// The agreement of the samples of one kind of surface.
+#[derive(Clone, Copy)]
+struct KindAgreement {
+    samples: u32,
+    /// Per light, how many samples traced it (a cone point below the surface traces none).
+    tested: [u8; 64],
+    /// Blocked by the real layer in every sample that traced it, in some sample.
     all_real: u64,
     any_real: u64,
-    /// Blocked by the objects only in every sample, in some sample.
+    /// Blocked by the objects only in every sample that traced it, in some sample.
     all_virtual: u64,
     any_virtual: u64,
 }
 
+/// Fewest samples that must have traced a light, all alike, before their answer is lent: a soft
+/// shadow's random first samples rarely agree by chance across this many (a cone half hidden,
+/// one time in 2^(n-1)).
+const MIN_AGREEING: u8 = 4;
+
+impl KindAgreement {
+    const EMPTY: KindAgreement = KindAgreement {
+        samples: 0,
+        tested: [0; 64],
+        all_real: u64::MAX,
+        any_real: 0,
+        all_virtual: u64::MAX,
+        any_virtual: 0,
+    };
+
+    fn add(&mut self, v: LightVisibility) {
+        self.samples += 1;
+        let mut bits = v.tested;
+        while bits != 0 {
+            self.tested[bits.trailing_zeros() as usize] += 1;
+            bits &= bits - 1;
+        }
+        // A sample that did not trace a light says nothing about it: neutral in the "every".
+        self.all_real &= v.real | !v.tested;
+        self.any_real |= v.real;
+        self.all_virtual &= v.virtual_only | !v.tested;
+        self.any_virtual |= v.virtual_only;
+    }
+
+    /// The lights that at least [`MIN_AGREEING`] samples traced, every one of them finding it
+    /// blocked alike, with those answers.
+    fn known(&self) -> LightVisibility {
+        let enough = self
+            .tested
+            .iter()
+            .enumerate()
+            .filter(|(_, n)| **n >= MIN_AGREEING)
+            .fold(0u64, |mask, (i, _)| mask | 1 << i);
+        let uniform =
+            enough & !(self.all_real ^ self.any_real) & !(self.all_virtual ^ self.any_virtual);
+        LightVisibility {
+            tested: uniform,
+            real: self.all_real & uniform,
+            virtual_only: self.all_virtual & uniform,
+        }
+    }
+}
+
 impl Agreement {
     fn new(first: FirstSample) -> Agreement {
-        let v = first.visibility;
         Agreement {
             primary: first.primary,
             silhouette: false,
-            with: Range::new(first.with),
-            without: Range::new(first.without),
-            tested: v.tested,
-            all_real: v.real,
-            any_real: v.real,
-            all_virtual: v.virtual_only,
-            any_virtual: v.virtual_only,
+            kinds: [KindAgreement::EMPTY; 2],
         }
     }
 
     fn add(&mut self, s: FirstSample) {
         self.silhouette |= s.primary != self.primary;
-        self.with.grow(s.with);
-        self.without.grow(s.without);
-        let v = s.visibility;
-        self.tested &= v.tested;
-        self.all_real &= v.real;
-        self.any_real |= v.real;
-        self.all_virtual &= v.virtual_only;
-        self.any_virtual |= v.virtual_only;
-    }
-
-    /// The lights every sample traced and found blocked alike, with those answers.
-    fn known(&self) -> KnownVisibility {
-        let uniform =
-            self.tested & !(self.all_real ^ self.any_real) & !(self.all_virtual ^ self.any_virtual);
-        KnownVisibility {
-            primary: self.primary,
-            lights: LightVisibility {
-                tested: uniform,
-                real: self.all_real & uniform,
-                virtual_only: self.all_virtual & uniform,
-            },
+        match s.primary {
+            PrimaryHit::Real => self.kinds[0].add(s.visibility),
+            PrimaryHit::Virtual => self.kinds[1].add(s.visibility),
+            PrimaryHit::Background => {}
         }
     }
-}
 
-/// The per-channel minimum and maximum of a set of colours.
-struct Range {
-    min: Rgb,
-    max: Rgb,
-}
-
-impl Range {
-    fn new(c: Rgb) -> Range {
-        Range { min: c, max: c }
-    }
-
-    fn grow(&mut self, c: Rgb) {
-        self.min = Rgb::new(
-            self.min.r.min(c.r),
-            self.min.g.min(c.g),
-            self.min.b.min(c.b),
-        );
-        self.max = Rgb::new(
-            self.max.r.max(c.r),
-            self.max.g.max(c.g),
-            self.max.b.max(c.b),
-        );
-    }
-
-    /// Whether a channel's contrast `(max - min) / (max + min)` exceeds `contrast` (written
-    /// without the division; a channel that is 0 throughout has none). The radiance of a
-    /// vertex is clamped at 0, so `max + min >= 0`.
-    fn exceeds(&self, contrast: f32) -> bool {
-        let over = |lo: f32, hi: f32| hi - lo > contrast * (hi + lo);
-        over(self.min.r, self.max.r) || over(self.min.g, self.max.g) || over(self.min.b, self.max.b)
+    /// Per kind of surface, the lights its samples all traced and found blocked alike.
+    fn known(&self) -> KnownVisibility {
+        KnownVisibility {
+            real: self.kinds[0].known(),
+            virtual_object: self.kinds[1].known(),
+        }
     }
 }
 
@@ -269,26 +292,36 @@ mod tests {
     }
 
     #[test]
-    fn contrast_is_measured_against_the_threshold() {
-        // max 1.05, min 1.0: contrast 0.05 / 2.05 = 0.0244.
+    fn the_deviation_from_the_neighbours_is_measured_against_the_threshold() {
+        // The centre 1.1 against neighbours of 1.0: 0.1 / 2.1 = 0.048.
         let mut v = [1.0; 9];
-        v[8] = 1.05;
+        v[4] = 1.1;
         let g = grid(&v, PrimaryHit::Real);
-        assert!(needs_refinement(&g, 3, 3, 1, 1, 0.04).is_none());
-        assert!(needs_refinement(&g, 3, 3, 1, 1, 0.02).is_some());
-        // The corner (2, 2) is outside (0, 0)'s neighbourhood.
+        assert!(needs_refinement(&g, 3, 3, 1, 1, 0.05).is_none());
+        assert!(needs_refinement(&g, 3, 3, 1, 1, 0.04).is_some());
+        // (0, 0) sees 1.1 among three neighbours: mean 1.033, 0.033 / 2.033 = 0.016.
         assert!(needs_refinement(&g, 3, 3, 0, 0, 0.02).is_none());
+        assert!(needs_refinement(&g, 3, 3, 0, 0, 0.01).is_some());
+    }
+
+    #[test]
+    fn a_smooth_gradient_keeps_one_sample() {
+        // A ramp of 10 % a pixel: the centre is its neighbours' mean.
+        let v = [1.0, 1.1, 1.2, 1.0, 1.1, 1.2, 1.0, 1.1, 1.2];
+        let g = grid(&v, PrimaryHit::Real);
+        assert!(needs_refinement(&g, 3, 3, 1, 1, 0.02).is_none());
     }
 
     #[test]
     fn a_change_of_primary_hit_refines_its_neighbours_only() {
         let mut g = grid(&[1.0; 9], PrimaryHit::Real);
         g[2] = sample(PrimaryHit::Virtual, 1.0);
-        // Across a silhouette nothing is known: every ray is traced.
-        assert_eq!(
-            needs_refinement(&g, 3, 3, 1, 1, 0.04),
-            Some(KnownVisibility::NONE)
-        );
+        // Across a silhouette each kind lends what enough of its samples agree on: eight real
+        // samples around (1, 1), one virtual (too few).
+        let known = needs_refinement(&g, 3, 3, 1, 1, 0.04).expect("refined");
+        assert_eq!(known.real.tested, 0b111);
+        assert_eq!(known.virtual_object, LightVisibility::NONE);
+        // (2, 0) sees three real samples and one virtual: nothing is lent.
         assert_eq!(
             needs_refinement(&g, 3, 3, 2, 0, 0.04),
             Some(KnownVisibility::NONE)
@@ -301,26 +334,28 @@ mod tests {
         // The layer without the objects is flat; the one with them has a shadowed sample.
         let mut g = grid(&[1.0; 9], PrimaryHit::Real);
         g[4].with = Rgb::new(1.0, 0.5, 1.0);
+        assert!(needs_refinement(&g, 3, 3, 1, 1, 0.04).is_some());
         assert!(needs_refinement(&g, 3, 3, 0, 0, 0.04).is_some());
     }
 
     #[test]
     fn later_samples_know_the_lights_blocked_alike_everywhere() {
         // Light 0 open everywhere, light 1 blocked by the real layer everywhere, light 2 blocked
-        // by the objects in one pixel only, light 3 traced in all but one pixel.
+        // by the objects in one pixel only, light 3 traced (open) in all but one pixel: the
+        // eight that traced it lend their answer.
         let mut g = grid(&[1.0; 9], PrimaryHit::Real);
         for s in &mut g {
             s.visibility.tested = 0b1111;
         }
         g[5].visibility.virtual_only = 0b100;
-        g[5].with = Rgb::splat(0.5);
+        g[4].with = Rgb::splat(0.5);
         g[7].visibility.tested = 0b0111;
         let known = needs_refinement(&g, 3, 3, 1, 1, 0.04).expect("refined");
-        assert_eq!(known.primary, PrimaryHit::Real);
+        assert_eq!(known.virtual_object, LightVisibility::NONE);
         assert_eq!(
-            known.lights,
+            known.real,
             LightVisibility {
-                tested: 0b0011,
+                tested: 0b1011,
                 real: 0b0010,
                 virtual_only: 0,
             }
@@ -340,19 +375,24 @@ mod tests {
         // traced there, light 0 taken from the grid.
         for (x, y) in [(1, 0), (1, 1), (3, 3), (4, 1), (0, 1)] {
             let k = grid.known(&coarse, x, y);
-            assert_eq!(k.lights.tested & 0b11, 0b01, "({x}, {y})");
+            assert_eq!(k.real.tested & 0b11, 0b01, "({x}, {y})");
         }
         // A larger image: (9, 9) is farther than 3 from image (2, 2).
         let grid = CoarseGrid::new(11, 11);
         let mut coarse = grid_of(36, PrimaryHit::Real);
         coarse[7].visibility.virtual_only = 0b10;
-        assert_eq!(grid.known(&coarse, 9, 9).lights.tested & 0b11, 0b11);
-        assert_eq!(grid.known(&coarse, 5, 5).lights.tested & 0b11, 0b01);
+        assert_eq!(grid.known(&coarse, 9, 9).real.tested & 0b11, 0b11);
+        assert_eq!(grid.known(&coarse, 5, 5).real.tested & 0b11, 0b01);
+        // Another kind of surface among the neighbours lends nothing to the first kind's rays,
+        // and fewer than four of a kind lend nothing to theirs.
         let grid = CoarseGrid::new(5, 5);
         let mut coarse = grid_of(9, PrimaryHit::Real);
-        // Another kind of surface among the neighbours: nothing is lent.
         coarse[0].primary = PrimaryHit::Virtual;
-        assert_eq!(grid.known(&coarse, 1, 0), KnownVisibility::NONE);
+        coarse[0].visibility.real = 0b111;
+        let k = grid.known(&coarse, 1, 0);
+        assert_eq!(k.real.tested & 0b111, 0b111);
+        assert_eq!(k.real.real & 0b111, 0b010);
+        assert_eq!(k.virtual_object, LightVisibility::NONE);
         assert!(CoarseGrid::is_coarse(2, 4) && !CoarseGrid::is_coarse(1, 2));
     }
 

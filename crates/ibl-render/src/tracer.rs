@@ -121,6 +121,13 @@ pub struct LightVisibility {
 }
 
 impl LightVisibility {
+    /// No light.
+    pub const NONE: LightVisibility = LightVisibility {
+        tested: 0,
+        real: 0,
+        virtual_only: 0,
+    };
+
     fn record(&mut self, index: usize, occlusion: Occlusion) {
         if index < VISIBILITY_LIGHTS {
             let bit = 1u64 << index;
@@ -149,29 +156,33 @@ impl LightVisibility {
     }
 }
 
-/// Shadow answers a path may take instead of tracing (adaptive antialiasing's second pass,
-/// [`crate::adaptive`]): where every first sample around a pixel found a light's ray blocked the
-/// same way, the pixel's later samples take that answer for that light. Used only at a camera
-/// ray's own hit, with the objects, when it is of the same kind as the neighbourhood's
-/// (`primary`).
+/// Shadow answers a path may take instead of tracing (adaptive antialiasing, [`crate::adaptive`]):
+/// where every first sample of one kind of surface around a pixel found a light's ray blocked
+/// the same way, the pixel's samples that meet that kind of surface take that answer for that
+/// light. Used only at a camera ray's own hit, with the objects.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct KnownVisibility {
-    /// What the camera rays of the neighbourhood met.
-    pub primary: PrimaryHit,
-    /// The lights whose answer is known (`tested`) and the answers.
-    pub lights: LightVisibility,
+    /// The answers for a camera ray that meets a real surface.
+    pub real: LightVisibility,
+    /// The answers for a camera ray that meets a virtual object.
+    pub virtual_object: LightVisibility,
 }
 
 impl KnownVisibility {
     /// Nothing known: every ray is traced.
     pub const NONE: KnownVisibility = KnownVisibility {
-        primary: PrimaryHit::Background,
-        lights: LightVisibility {
-            tested: 0,
-            real: 0,
-            virtual_only: 0,
-        },
+        real: LightVisibility::NONE,
+        virtual_object: LightVisibility::NONE,
     };
+
+    /// The answers for a camera ray that met `primary`.
+    fn for_hit(&self, primary: PrimaryHit) -> LightVisibility {
+        match primary {
+            PrimaryHit::Real => self.real,
+            PrimaryHit::Virtual => self.virtual_object,
+            PrimaryHit::Background => LightVisibility::NONE,
+        }
+    }
 }
 
 /// Whether a ray towards a distant light is blocked, and by which layer.
@@ -303,6 +314,9 @@ pub struct Tracer<'a> {
     bounces: u32,
     /// Per light of the lighting's light list, its cone's shading table (soft lights).
     cone_shading: Vec<Option<ConeShading>>,
+    /// Whether every real triangle lies in one plane (a ground): then no ray leaving a real
+    /// surface towards its geometric normal's side can meet the real layer.
+    flat_real_layer: bool,
 }
 
 /// Vertex count from which Russian roulette may end a path.
@@ -318,6 +332,9 @@ struct PathState<'h> {
     known: LightVisibility,
     /// The answers at the vertex being shaded (camera hits only).
     seen: LightVisibility,
+    /// The vertex being shaded lies on a flat real layer ([`Tracer`]'s `flat_real_layer`): its
+    /// rays, which all leave towards the geometric normal's side, skip the real layer.
+    on_flat_real: bool,
 }
 
 /// Per light, the triangles of the real and the virtual layer that last blocked its shadow ray
@@ -357,6 +374,7 @@ impl<'a> Tracer<'a> {
             lighting,
             bounces: bounces.max(1),
             cone_shading,
+            flat_real_layer: is_flat(&scene.real.triangles),
         }
     }
 
@@ -364,7 +382,7 @@ impl<'a> Tracer<'a> {
     /// the lights' shadow rays (keep one per thread; the result does not depend on it).
     ///
     /// `known` gives shadow answers the path takes instead of tracing at the camera ray's own
-    /// hit when that hit is of `known.primary`'s kind ([`KnownVisibility::NONE`]: none).
+    /// hit, for the kind of surface it meets ([`KnownVisibility::NONE`]: none).
     pub fn trace(
         &self,
         ray: Ray,
@@ -380,6 +398,7 @@ impl<'a> Tracer<'a> {
             hints,
             known: LightVisibility::default(),
             seen: LightVisibility::default(),
+            on_flat_real: false,
         };
         let mut radiance = Rgb::ZERO;
         let mut throughput = Rgb::ONE;
@@ -395,14 +414,15 @@ impl<'a> Tracer<'a> {
                 radiance += throughput * self.escaped(ray.direction, bsdf_pdf);
                 break;
             };
+            state.on_flat_real = self.flat_real_layer && !is_virtual;
             if vertex == 0 {
                 primary = if is_virtual {
                     PrimaryHit::Virtual
                 } else {
                     PrimaryHit::Real
                 };
-                if layers == Layers::WithObjects && known.primary == primary {
-                    state.known = known.lights;
+                if layers == Layers::WithObjects {
+                    state.known = known.for_hit(primary);
                 }
             } else {
                 state.known = LightVisibility::default();
@@ -544,7 +564,9 @@ impl<'a> Tracer<'a> {
     /// the same in every sample, so a pixel's samples differ only where a cone is partly or
     /// wholly hidden, which is what adaptive antialiasing ([`crate::adaptive`]) looks for. A
     /// cone point below the shading surface adds nothing (`c_s = 0`) and sends no ray; one above
-    /// it but below the geometric surface is blocked by the surface itself.
+    /// it but below the geometric surface is blocked by the surface itself. A light whose answer
+    /// is known for the whole cone (adaptive antialiasing's agreeing neighbours) adds its exact
+    /// light where open and nothing where blocked, with no cone point.
     fn lights(
         &self,
         list: &LightList,
@@ -569,17 +591,18 @@ impl<'a> Tracer<'a> {
                         stream.skip_2d();
                         continue;
                     }
-                    // The unshadowed cone, exact, in every layer; then what the cone point's
-                    // ray finds blocked is taken off where it is blocked.
                     let light_value = f * light.irradiance;
-                    sum.add_all(light_value * mean_cos);
-                    let known = state.known.occlusion(index);
-                    if known == Some(Occlusion::Open) {
-                        // Known open from the neighbourhood: nothing to take off, no point needed.
+                    if let Some(occlusion) = state.known.occlusion(index) {
+                        // Known from the neighbourhood for the whole cone: its exact light where
+                        // it is open, nothing where it is blocked; no cone point is needed.
                         stream.skip_2d();
-                        self.known_occlusion(index, Occlusion::Open, state);
+                        let occlusion = self.known_occlusion(index, occlusion, state);
+                        sum.add(occlusion, light_value * mean_cos);
                         continue;
                     }
+                    // The unshadowed cone, exact, in every layer; then what the cone point's
+                    // ray finds blocked is taken off where it is blocked.
+                    sum.add_all(light_value * mean_cos);
                     let [u1, u2] = stream.next_2d();
                     let point = light.frame.to_world(cone.sample(u1, u2));
                     let cos = surface.shading_normal.dot(point);
@@ -592,10 +615,7 @@ impl<'a> Tracer<'a> {
                         // itself hides it (as in `Vertex::reflection`), in every layer.
                         Occlusion::Real
                     } else {
-                        match known {
-                            Some(occlusion) => self.known_occlusion(index, occlusion, state),
-                            None => self.light_occlusion(origin, point, index, state),
-                        }
+                        self.light_occlusion(origin, point, index, state)
                     };
                     sum.add_blocked(occlusion, light_value * -cos);
                 }
@@ -758,11 +778,12 @@ impl<'a> Tracer<'a> {
         state.rays += 1;
         let ray = Ray::new(origin, wi);
         let [real, virtual_layer] = state.hints.light(index);
-        if self
-            .scene
-            .real
-            .bvh
-            .occluded_by(&ray, 0.0, f32::INFINITY, real)
+        if !state.on_flat_real
+            && self
+                .scene
+                .real
+                .bvh
+                .occluded_by(&ray, 0.0, f32::INFINITY, real)
         {
             return Occlusion::Real;
         }
@@ -790,7 +811,7 @@ impl<'a> Tracer<'a> {
     ) -> Occlusion {
         state.rays += 1;
         let ray = Ray::new(origin, wi);
-        if self.scene.real.bvh.occluded(&ray, 0.0, t_max) {
+        if !state.on_flat_real && self.scene.real.bvh.occluded(&ray, 0.0, t_max) {
             return Occlusion::Real;
         }
         if state.layers == Layers::WithObjects
@@ -801,6 +822,30 @@ impl<'a> Tracer<'a> {
         }
         Occlusion::Open
     }
+}
+
+/// Whether all of `triangles` lie in one plane, to 1e-6 of their extent (false when there are
+/// none or all are degenerate): the plane of the first triangle with an area, every corner
+/// checked against it. A ray leaving such a layer's surface on the side it leaves cannot meet
+/// the layer again (the intersection test would reject the hit at `t = 0` anyway); the
+/// tolerance is far below the rays' origin offsets' effect on anything but grazing rays.
+fn is_flat(triangles: &[[Vec3; 3]]) -> bool {
+    let Some((normal, corner)) = triangles.iter().find_map(|[a, b, c]| {
+        let n = (*b - *a).cross(*c - *a);
+        (n.length_squared() > 0.0).then(|| (n.normalize(), *a))
+    }) else {
+        return false;
+    };
+    let extent = triangles
+        .iter()
+        .flatten()
+        .map(|p| p.abs().max_element())
+        .fold(0.0f32, f32::max);
+    let tolerance = 1e-6 * extent.max(f32::MIN_POSITIVE);
+    triangles
+        .iter()
+        .flatten()
+        .all(|p| normal.dot(*p - corner).abs() <= tolerance)
 }
 
 /// How far above the shading horizon [`cone_bsdf`] reads a lobe whose cone axis is below it
@@ -861,4 +906,35 @@ pub fn offset_origin(surface: &SurfacePoint, wi: Vec3) -> Vec3 {
         away(p.y, offset.y),
         away(p.z, offset.z),
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_ground_is_flat_and_a_box_is_not() {
+        let quad = [
+            [
+                Vec3::new(-20.0, -1.0, -20.0),
+                Vec3::new(20.0, -1.0, -20.0),
+                Vec3::new(20.0, -1.0, 20.0),
+            ],
+            [
+                Vec3::new(-20.0, -1.0, -20.0),
+                Vec3::new(20.0, -1.0, 20.0),
+                Vec3::new(-20.0, -1.0, 20.0),
+            ],
+        ];
+        assert!(is_flat(&quad));
+        // A tilted plane through rounding.
+        let tilt = glam::Quat::from_rotation_x(0.3);
+        let tilted: Vec<[Vec3; 3]> = quad.iter().map(|t| t.map(|p| tilt * p)).collect();
+        assert!(is_flat(&tilted));
+        let mut bent = quad;
+        bent[1][2].y = -0.99;
+        assert!(!is_flat(&bent));
+        assert!(!is_flat(&[]));
+        assert!(!is_flat(&[[Vec3::ZERO; 3]]));
+    }
 }

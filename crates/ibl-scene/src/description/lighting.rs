@@ -33,13 +33,15 @@ pub struct LightingDescription {
     /// every light once, its soft-shadow cone stratified across the samples). Default 4.
     #[serde(default = "default_lights_spp")]
     pub spp: u32,
-    /// Adaptive antialiasing (Mitchell 1987): every pixel takes one sample first, and only
-    /// pixels whose 3 x 3 neighbourhood differs (a silhouette, a penumbra, a change of surface)
-    /// take the rest of `spp`. Default `true`; `false` gives every pixel all `spp` samples.
+    /// Adaptive antialiasing (after Mitchell 1987): every pixel takes one sample first, and only
+    /// pixels whose first sample differs from its 3 x 3 neighbourhood's (a silhouette, a
+    /// penumbra, a change of surface) take the rest of `spp`. Default `true`; `false` gives
+    /// every pixel all `spp` samples.
     #[serde(default = "default_adaptive")]
     pub adaptive: bool,
-    /// The contrast `(max - min) / (max + min)` over a pixel's neighbourhood, per channel, above
-    /// which an adaptive pixel takes all `spp` samples. Default 0.04, in `(0, 1]`.
+    /// The deviation `|value - mean| / (value + mean)` of a pixel's first sample from its
+    /// neighbours' mean, per channel, above which an adaptive pixel takes all `spp` samples.
+    /// Default 0.02, in `(0, 1]`.
     #[serde(default = "default_adaptive_contrast")]
     pub adaptive_contrast: f32,
     /// SH bands of the hybrid ambient. Default 3.
@@ -72,7 +74,7 @@ fn default_adaptive() -> bool {
     true
 }
 fn default_adaptive_contrast() -> f32 {
-    0.04
+    0.02
 }
 fn default_bands() -> u32 {
     3
