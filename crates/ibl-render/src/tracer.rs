@@ -767,7 +767,7 @@ impl<'a> Tracer<'a> {
         occlusion
     }
 
-    /// The shadow ray of [`Tracer::light_occlusion`], traced.
+    /// The shadow ray of [`Tracer::light_occlusion`], traced, with light `index`'s hints.
     fn traced_light_occlusion(
         &self,
         origin: Vec3,
@@ -775,29 +775,10 @@ impl<'a> Tracer<'a> {
         index: usize,
         state: &mut PathState,
     ) -> Occlusion {
-        state.rays += 1;
-        let ray = Ray::new(origin, wi);
-        let [real, virtual_layer] = state.hints.light(index);
-        if !state.on_flat_real
-            && self
-                .scene
-                .real
-                .bvh
-                .occluded_by(&ray, 0.0, f32::INFINITY, real)
-        {
-            return Occlusion::Real;
-        }
-        if state.layers == Layers::WithObjects
-            && self
-                .scene
-                .virtual_objects
-                .bvh
-                .occluded_by(&ray, 0.0, f32::INFINITY, virtual_layer)
-        {
-            state.touched_virtual = true;
-            return Occlusion::Virtual;
-        }
-        Occlusion::Open
+        let mut hints = *state.hints.light(index);
+        let occlusion = self.blocked(origin, wi, f32::INFINITY, &mut hints, state);
+        *state.hints.light(index) = hints;
+        occlusion
     }
 
     /// What blocks the segment from `origin` along the unit `wi` to distance `t_max` (a point
@@ -809,13 +790,32 @@ impl<'a> Tracer<'a> {
         t_max: f32,
         state: &mut PathState,
     ) -> Occlusion {
+        self.blocked(origin, wi, t_max, &mut [OccluderHint::NONE; 2], state)
+    }
+
+    /// One shadow ray: the real layer (unless the vertex lies on a flat one), then, in the walk
+    /// with the objects, the virtual layer, each testing its triangle in `hints` (`[real,
+    /// virtual]`) first and leaving its blocker there.
+    fn blocked(
+        &self,
+        origin: Vec3,
+        wi: Vec3,
+        t_max: f32,
+        hints: &mut [OccluderHint; 2],
+        state: &mut PathState,
+    ) -> Occlusion {
         state.rays += 1;
         let ray = Ray::new(origin, wi);
-        if !state.on_flat_real && self.scene.real.bvh.occluded(&ray, 0.0, t_max) {
+        let [real, virtual_layer] = hints;
+        if !state.on_flat_real && self.scene.real.bvh.occluded_by(&ray, 0.0, t_max, real) {
             return Occlusion::Real;
         }
         if state.layers == Layers::WithObjects
-            && self.scene.virtual_objects.bvh.occluded(&ray, 0.0, t_max)
+            && self
+                .scene
+                .virtual_objects
+                .bvh
+                .occluded_by(&ray, 0.0, t_max, virtual_layer)
         {
             state.touched_virtual = true;
             return Occlusion::Virtual;
