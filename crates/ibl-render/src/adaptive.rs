@@ -30,11 +30,11 @@
 //! a light's shadow ray blocked the same way (open, blocked by the real layer, or by the objects
 //! only), the later samples take that answer for that light ([`KnownVisibility`]) and trace the
 //! others: the lights whose shadow edge passes through the neighbourhood. Each kind of surface
-//! lends its own answers (across a silhouette too), and only for a light that at least four of
-//! its samples traced (a cone point below the surface traces nothing and says nothing). A shadow edge
-//! thinner than the first samples' spacing is what this can miss. A pixel left at one sample is
-//! its own sample 0, which for a smooth neighbourhood differs from the pixel's mean by less than
-//! the deviation the test allows.
+//! lends its own answers (across a silhouette too), and only for a light that at least six of
+//! its samples traced (a cone point below the surface traces nothing and says nothing). A
+//! shadow edge thinner than the first samples' spacing is what this can miss. A pixel left at
+//! one sample is its own sample 0, which for a smooth neighbourhood differs from the pixel's
+//! mean by less than the deviation the test allows.
 //!
 //! The first pass itself runs on a coarse grid first ([`CoarseGrid`]): pixels with even `x` and
 //! `y` trace every light, and the others take the answers of the lights their coarse neighbours
@@ -188,7 +188,7 @@ struct KindAgreement {
 /// Fewest samples that must have traced a light, all alike, before their answer is lent: a soft
 /// shadow's random first samples rarely agree by chance across this many (a cone half hidden,
 /// one time in 2^(n-1)).
-const MIN_AGREEING: u8 = 4;
+const MIN_AGREEING: u8 = 6;
 
 impl KindAgreement {
     const EMPTY: KindAgreement = KindAgreement {
@@ -384,12 +384,12 @@ mod tests {
         assert_eq!(grid.known(&coarse, 9, 9).real.tested & 0b11, 0b11);
         assert_eq!(grid.known(&coarse, 5, 5).real.tested & 0b11, 0b01);
         // Another kind of surface among the neighbours lends nothing to the first kind's rays,
-        // and fewer than four of a kind lend nothing to theirs.
-        let grid = CoarseGrid::new(5, 5);
-        let mut coarse = grid_of(9, PrimaryHit::Real);
+        // and fewer than six of a kind lend nothing to theirs: (3, 3) sees 4 x 4 coarse pixels,
+        // one of them virtual.
+        let mut coarse = grid_of(36, PrimaryHit::Real);
         coarse[0].primary = PrimaryHit::Virtual;
         coarse[0].visibility.real = 0b111;
-        let k = grid.known(&coarse, 1, 0);
+        let k = grid.known(&coarse, 3, 3);
         assert_eq!(k.real.tested & 0b111, 0b111);
         assert_eq!(k.real.real & 0b111, 0b010);
         assert_eq!(k.virtual_object, LightVisibility::NONE);
