@@ -201,7 +201,10 @@ pub fn render(
             .flat_map_iter(|y| {
                 let mut hints = ShadowHints::default();
                 let row: Vec<PixelSums> = (0..w)
-                    .map(|x| sampler.samples(x, y, 0..settings.spp, &mut hints))
+                    .map(|x| {
+                        let known = &KnownVisibility::NONE;
+                        sampler.samples(x, y, 0..settings.spp, &mut hints, known)
+                    })
                     .collect();
                 row_done();
                 row
@@ -218,14 +221,13 @@ pub fn render(
                 .into_par_iter()
                 .flat_map_iter(|j| {
                     let mut hints = ShadowHints::default();
-                    let row: Vec<FirstSample> = (0..cw)
+                    (0..cw)
                         .map(|i| {
                             let known = &KnownVisibility::NONE;
-                            let pixel = sampler.first_sample(2 * i, 2 * j, &mut hints, known);
+                            let pixel = sampler.samples(2 * i, 2 * j, 0..1, &mut hints, known);
                             pixel.first_sample()
                         })
-                        .collect();
-                    row
+                        .collect::<Vec<_>>()
                 })
                 .collect();
             let mut sums: Vec<PixelSums> = (0..h)
@@ -239,7 +241,7 @@ pub fn render(
                             } else {
                                 grid.known(&coarse, x, y)
                             };
-                            sampler.first_sample(x, y, &mut hints, &known)
+                            sampler.samples(x, y, 0..1, &mut hints, &known)
                         })
                         .collect();
                     row_done();
@@ -367,29 +369,17 @@ struct PixelSampler<'a> {
 }
 
 impl PixelSampler<'_> {
-    /// The sums of samples `samples` of pixel `(x, y)`.
+    /// The sums of samples `samples` of pixel `(x, y)`, taking the shadow answers `known`.
     fn samples(
         &self,
         x: usize,
         y: usize,
         samples: Range<u32>,
         hints: &mut ShadowHints,
-    ) -> PixelSums {
-        let mut sums = PixelSums::default();
-        self.add_samples(&mut sums, x, y, samples, hints, &KnownVisibility::NONE);
-        sums
-    }
-
-    /// The sums of sample 0 of pixel `(x, y)`, taking the shadow answers `known`.
-    fn first_sample(
-        &self,
-        x: usize,
-        y: usize,
-        hints: &mut ShadowHints,
         known: &KnownVisibility,
     ) -> PixelSums {
         let mut sums = PixelSums::default();
-        self.add_samples(&mut sums, x, y, 0..1, hints, known);
+        self.add_samples(&mut sums, x, y, samples, hints, known);
         sums
     }
 

@@ -312,7 +312,7 @@ pub struct Tracer<'a> {
     scene: &'a Scene,
     lighting: &'a Lighting,
     bounces: u32,
-    /// Per light of the lighting's light list, its cone's shading table (soft lights).
+    /// Per light of the lighting's light list, its cone's shading table (soft shadows only).
     cone_shading: Vec<Option<ConeShading>>,
     /// Whether every real triangle lies in one plane (a ground): then no ray leaving a real
     /// surface towards its geometric normal's side can meet the real layer.
@@ -362,12 +362,15 @@ impl<'a> Tracer<'a> {
     /// lights and hybrid modes end at the first diffuse or glossy one).
     pub fn new(scene: &'a Scene, lighting: &'a Lighting, bounces: u32) -> Tracer<'a> {
         let cone_shading = match &lighting.illumination {
-            Illumination::Lights(list) | Illumination::Hybrid(list, _) => list
-                .lights
-                .iter()
-                .map(|l| l.cone.map(ConeShading::new))
-                .collect(),
-            Illumination::Environment => Vec::new(),
+            Illumination::Lights(list) | Illumination::Hybrid(list, _)
+                if list.shadows == ShadowKind::Soft =>
+            {
+                list.lights
+                    .iter()
+                    .map(|l| l.cone.map(ConeShading::new))
+                    .collect()
+            }
+            _ => Vec::new(),
         };
         Tracer {
             scene,
@@ -554,8 +557,9 @@ impl<'a> Tracer<'a> {
     ///
     /// A hard light adds `f(w_o, l) cos(theta_l) I` where its ray along `l` is open. A soft light
     /// (a cone of uniform radiance `L`, `I = L A`) adds `f I (mean_cone(max(0, n . w)) - c_s
-    /// (1 - V(w_s)))`: its unshadowed light exact ([`crate::sampling::UniformCone::
-    /// mean_clamped_cosine`], through [`ConeShading`], also where the horizon cuts the cone),
+    /// (1 - V(w_s)))`: its unshadowed light exact
+    /// ([`crate::sampling::UniformCone::mean_clamped_cosine`], through [`ConeShading`], also
+    /// where the horizon cuts the cone),
     /// less what the cone point `w_s` (uniform in the cone) finds blocked, `c_s = max(0, n .
     /// w_s)`. Since `E[c_s] = mean_cone(max(0, n . w))` this is a control variate: its
     /// expectation is the cone's shadowed light `f L int_cone max(0, n . w) V(w) dw` (for a
@@ -748,7 +752,9 @@ impl<'a> Tracer<'a> {
         if let Some(occlusion) = state.known.occlusion(index) {
             return self.known_occlusion(index, occlusion, state);
         }
-        let occlusion = self.traced_light_occlusion(origin, wi, index, state);
+        let mut hints = *state.hints.light(index);
+        let occlusion = self.blocked(origin, wi, f32::INFINITY, &mut hints, state);
+        *state.hints.light(index) = hints;
         state.seen.record(index, occlusion);
         occlusion
     }
@@ -764,20 +770,6 @@ impl<'a> Tracer<'a> {
             state.touched_virtual = true;
         }
         state.seen.record(index, occlusion);
-        occlusion
-    }
-
-    /// The shadow ray of [`Tracer::light_occlusion`], traced, with light `index`'s hints.
-    fn traced_light_occlusion(
-        &self,
-        origin: Vec3,
-        wi: Vec3,
-        index: usize,
-        state: &mut PathState,
-    ) -> Occlusion {
-        let mut hints = *state.hints.light(index);
-        let occlusion = self.blocked(origin, wi, f32::INFINITY, &mut hints, state);
-        *state.hints.light(index) = hints;
         occlusion
     }
 
