@@ -19,6 +19,11 @@ use clap::{Parser, Subcommand};
 #[derive(Parser)]
 #[command(name = "ibl", version, about, long_about = None, after_help = EXAMPLES)]
 struct Cli {
+    /// Refuse images of more pixels than this, before decoding or writing them (default 2^28 =
+    /// 268435456; also the IBL_MAX_PIXELS environment variable). A file whose header announces
+    /// more is refused at once, whatever its size on disk.
+    #[arg(long, global = true, value_name = "N")]
+    max_pixels: Option<usize>,
     #[command(subcommand)]
     command: Command,
 }
@@ -38,6 +43,9 @@ Examples:
   ibl capture merge IMG_*.jpg -o probe.exr   bracketed exposures to HDR
   ibl outdoor assets/outdoor/courtyard/scene.toml --out day   sun and sky per frame, composites
   ibl view assets/scenes/bunny-sky.toml      real-time viewer: 16 shadowed lights, edit, save
+
+Limits: images over 2^28 pixels are refused before decoding; lower (or raise) it with
+--max-pixels N or IBL_MAX_PIXELS=N.
 
 Exit codes: 0 success, 1 internal failure, 2 bad input or arguments.";
 
@@ -90,6 +98,14 @@ fn main() -> ExitCode {
             });
         }
     };
+    let limit = match cli.max_pixels {
+        Some(n) => ibl_io::set_default_max_pixels(n).map_err(|e| format!("--max-pixels: {e}")),
+        None => ibl_io::max_pixels_from_environment().map(|_| ()),
+    };
+    if let Err(e) = limit {
+        eprintln!("ibl: {e}");
+        return ExitCode::from(failure::EXIT_BAD_INPUT);
+    }
     let result = match cli.command {
         Command::Info(args) => cmd::info::run(&args),
         Command::Convert(args) => cmd::convert::run(&args),

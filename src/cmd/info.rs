@@ -17,7 +17,8 @@ Examples:
   ibl info probe.hdr --json | jq .brightest
   ibl info ball.exr --mapping mirror-ball
   ibl info env.ktx2                         # a KTX2/DDS cube: format, levels, faces
-  ibl info probe.exr --frame blender        # brightest direction in Blender's Z-up axes")]
+  ibl info probe.exr --frame blender        # brightest direction in Blender's Z-up axes
+  ibl info huge.jpg --header                # size and format only, nothing decoded")]
 pub struct InfoArgs {
     /// The image to describe (.hdr, .exr, .pfm, .png, .jpg; .ktx2 and .dds: level 0, a cube map
     /// as its six faces side by side).
@@ -32,6 +33,10 @@ pub struct InfoArgs {
     /// Axes in which to print the brightest direction: gltf (ours), paper, threejs, blender.
     #[arg(long, default_value = "gltf", value_name = "PRESET", value_parser = values::frame)]
     pub frame: FramePreset,
+    /// Read only the header: format, size and the mapping its shape names, at once and without
+    /// decoding a pixel, whatever the image's size (no statistics).
+    #[arg(long)]
+    pub header: bool,
     /// Print one JSON object instead of text.
     #[arg(long)]
     pub json: bool,
@@ -44,6 +49,31 @@ pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
         .as_deref()
         .map(|m| EnvMapping::parse(m, args.fov))
         .transpose()?;
+    if args.header {
+        let h = ibl_pipeline::info::header_info(&args.file, mapping)?;
+        if args.json {
+            println!("{}", serde_json::to_string_pretty(&h)?);
+        } else {
+            let guessed = if h.mapping_guessed {
+                " (guessed from shape)"
+            } else {
+                ""
+            };
+            let limits = if h.within_limits {
+                "within the limits"
+            } else {
+                "over the pixel limit: refused unless --max-pixels allows it"
+            };
+            println!("file        {}", h.file);
+            println!("format      {}", h.format);
+            println!(
+                "size        {} x {} ({} pixels, {limits})",
+                h.width, h.height, h.pixels
+            );
+            println!("mapping     {}{guessed}", h.mapping);
+        }
+        return Ok(());
+    }
     let info = ibl_pipeline::info::probe_info(&args.file, mapping, args.frame)?;
     if args.json {
         println!("{}", serde_json::to_string_pretty(&info)?);

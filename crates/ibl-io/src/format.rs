@@ -5,6 +5,8 @@
 //! it says); the magic bytes are only used to give a helpful hint when the two disagree.
 
 use std::path::Path;
+use std::sync::OnceLock;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 use ibl_core::{Image, Rgb};
 
@@ -133,16 +135,77 @@ pub struct Limits {
     pub max_width: usize,
     /// Largest accepted height in pixels (default 65536).
     pub max_height: usize,
-    /// Largest accepted `width * height` (default 2^28, i.e. 3 GiB of `Rgb` pixels).
+    /// Largest accepted `width * height` (default 2^28, i.e. 3 GiB of `Rgb` pixels, or what the
+    /// process set: [`set_default_max_pixels`], [`MAX_PIXELS_VARIABLE`]).
     pub max_pixels: usize,
 }
 
+/// The built-in pixel limit, 2^28 pixels (3 GiB of `Rgb` pixels).
+pub const DEFAULT_MAX_PIXELS: usize = 1 << 28;
+
+/// The largest pixel limit a user may set: every 65536 x 65536 image.
+pub const MAX_MAX_PIXELS: usize = 1 << 32;
+
+/// The environment variable that sets the pixel limit of [`Limits::default`] for a process.
+pub const MAX_PIXELS_VARIABLE: &str = "IBL_MAX_PIXELS";
+
+/// The pixel limit set by [`set_default_max_pixels`]; 0 when none was set.
+static SET_MAX_PIXELS: AtomicUsize = AtomicUsize::new(0);
+
+/// Sets the pixel limit of [`Limits::default`] for the rest of the process (the CLI's
+/// `--max-pixels`), over [`MAX_PIXELS_VARIABLE`]. Values outside `1..=MAX_MAX_PIXELS` are
+/// refused with a message.
+pub fn set_default_max_pixels(max_pixels: usize) -> Result<(), String> {
+    check_max_pixels(max_pixels)?;
+    SET_MAX_PIXELS.store(max_pixels, Ordering::Relaxed);
+    Ok(())
+}
+
+/// The pixel limit [`MAX_PIXELS_VARIABLE`] asks for: `Ok(None)` when it is not set, an error
+/// naming the variable when it is not a whole number in `1..=MAX_MAX_PIXELS`.
+pub fn max_pixels_from_environment() -> Result<Option<usize>, String> {
+    let Some(raw) = std::env::var_os(MAX_PIXELS_VARIABLE) else {
+        return Ok(None);
+    };
+    let text = raw.to_string_lossy();
+    let value: usize = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("{MAX_PIXELS_VARIABLE}={text:?} is not a whole number of pixels"))?;
+    check_max_pixels(value).map_err(|e| format!("{MAX_PIXELS_VARIABLE}: {e}"))?;
+    Ok(Some(value))
+}
+
+fn check_max_pixels(value: usize) -> Result<(), String> {
+    if (1..=MAX_MAX_PIXELS).contains(&value) {
+        Ok(())
+    } else {
+        Err(format!(
+            "a pixel limit of {value} is not in 1..={MAX_MAX_PIXELS}"
+        ))
+    }
+}
+
+/// The process's pixel limit: [`set_default_max_pixels`], else a valid [`MAX_PIXELS_VARIABLE`]
+/// (an invalid one is ignored here; the CLI refuses it at start), else [`DEFAULT_MAX_PIXELS`].
+fn default_max_pixels() -> usize {
+    static FROM_ENVIRONMENT: OnceLock<Option<usize>> = OnceLock::new();
+    match SET_MAX_PIXELS.load(Ordering::Relaxed) {
+        0 => FROM_ENVIRONMENT
+            .get_or_init(|| max_pixels_from_environment().ok().flatten())
+            .unwrap_or(DEFAULT_MAX_PIXELS),
+        set => set,
+    }
+}
+
 impl Default for Limits {
+    /// 65536 pixels a side and [`DEFAULT_MAX_PIXELS`] in all, unless the process set another
+    /// pixel limit ([`set_default_max_pixels`], [`MAX_PIXELS_VARIABLE`]).
     fn default() -> Self {
         Limits {
             max_width: 65536,
             max_height: 65536,
-            max_pixels: 1 << 28,
+            max_pixels: default_max_pixels(),
         }
     }
 }
@@ -154,6 +217,16 @@ impl Limits {
         max_height: usize::MAX,
         max_pixels: usize::MAX,
     };
+
+    /// The largest image file read whole under these limits, bytes: 24 bytes a pixel (an
+    /// uncompressed 32-bit RGBA OpenEXR is 16, a cube texture's mip chain adds a third) plus
+    /// 16 MiB of headers, tables and metadata. Reads are bounded by it before anything is
+    /// decoded, so a device or a sparse file of any size is refused.
+    pub fn max_file_bytes(&self) -> u64 {
+        (self.max_pixels as u64)
+            .saturating_mul(24)
+            .saturating_add(16 << 20)
+    }
 
     /// Checks a header's size: zero sizes are invalid, sizes over a limit are a
     /// [`DecodeError::Limits`]. Returns `width * height`.

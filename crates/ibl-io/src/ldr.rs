@@ -71,6 +71,19 @@ pub(crate) fn limited_reader<'a>(
     reader
 }
 
+/// The image size (width, height) a PNG or JPEG header announces, from the header alone (no
+/// pixel is decoded; `bytes` may be only the start of the file).
+pub fn header_size(bytes: &[u8]) -> Result<(usize, usize), DecodeError> {
+    let format = match ImageFormat::sniff(bytes) {
+        Some(ImageFormat::Png) => image::ImageFormat::Png,
+        Some(ImageFormat::Jpeg) => image::ImageFormat::Jpeg,
+        _ => return Err(wrong_magic("a PNG or JPEG file", bytes)),
+    };
+    let reader = limited_reader(bytes, format, &Limits::UNLIMITED);
+    let (w, h) = reader.into_dimensions().map_err(from_image_error)?;
+    Ok((w as usize, h as usize))
+}
+
 /// Decodes a PNG or JPEG file held in memory to linear RGB (row 0 at the top).
 pub fn decode(bytes: &[u8], limits: &Limits) -> Result<RawImage, DecodeError> {
     let format = match ImageFormat::sniff(bytes) {

@@ -21,11 +21,13 @@
 //! file untouched (`docs/CONVENTIONS.md`, section 7).
 
 pub mod area_light_file;
+mod bounded_read;
 pub mod dds;
 mod error;
 pub mod exr;
 mod format;
 pub mod hdr;
+pub mod header;
 pub mod ktx2;
 pub mod ldr;
 pub mod light_export;
@@ -46,9 +48,14 @@ use std::path::{Path, PathBuf};
 
 use ibl_core::{Image, Rgb};
 
+pub use bounded_read::{check_regular, read_bounded, read_prefix, read_text};
 pub use error::{DecodeError, EncodeError, IoError};
 pub use exr::{ExrCompression, ExrOptions, ExrPrecision};
-pub use format::{ImageFormat, Limits, RawImage};
+pub use format::{
+    DEFAULT_MAX_PIXELS, ImageFormat, Limits, MAX_MAX_PIXELS, MAX_PIXELS_VARIABLE, RawImage,
+    max_pixels_from_environment, set_default_max_pixels,
+};
+pub use header::{ImageHeader, read_header};
 use ibl_core::tonemap::{Display, to_srgb8};
 pub use light_export::{ExportError, ExportOptions, LightFormat, write_light_file};
 pub use mesh_file::{LoadedMesh, MeshLimits, read_mesh};
@@ -128,7 +135,7 @@ fn texture_level0(decoded: DecodedTexture) -> RawImage {
 /// Reads a KTX2 or DDS texture with every level and face (the format from the extension).
 pub fn read_texture(path: &Path, limits: &Limits) -> Result<DecodedTexture, IoError> {
     let format = format_of(path)?;
-    let bytes = std::fs::read(path).map_err(|e| IoError::read(path, e))?;
+    let bytes = read_bounded(path, limits.max_file_bytes())?;
     let decoded = match format {
         ImageFormat::Ktx2 => ktx2::decode(&bytes, limits),
         ImageFormat::Dds => dds::decode(&bytes, limits),
@@ -231,29 +238,6 @@ pub fn read_images_in(dir: &Path, extension: &str) -> Result<Vec<(String, Image<
         .collect()
 }
 
-/// Reads a whole file after checking its size against `max_bytes`.
-pub(crate) fn read_bounded(path: &Path, max_bytes: u64) -> Result<Vec<u8>, IoError> {
-    let len = std::fs::metadata(path)
-        .map_err(|e| IoError::read(path, e))?
-        .len();
-    if len > max_bytes {
-        return Err(IoError::Limits {
-            path: path.to_path_buf(),
-            what: format!("{len} bytes, over the limit of {max_bytes}"),
-        });
-    }
-    std::fs::read(path).map_err(|e| IoError::read(path, e))
-}
-
-/// Reads a UTF-8 text file of at most `max_bytes` (a list of exposure times, a response curve).
-pub fn read_text(path: &Path, max_bytes: u64) -> Result<String, IoError> {
-    let bytes = read_bounded(path, max_bytes)?;
-    String::from_utf8(bytes).map_err(|e| IoError::Invalid {
-        path: path.to_path_buf(),
-        reason: format!("not UTF-8 text: {e}"),
-    })
-}
-
 /// The entries of a folder, sorted by path. An unreadable or missing folder is
 /// [`IoError::Io`] (bad input when it does not exist).
 pub fn list_dir(dir: &Path) -> Result<Vec<PathBuf>, IoError> {
@@ -277,7 +261,7 @@ pub fn read_image(path: &Path) -> Result<LoadedImage, IoError> {
 /// before allocating; negative, NaN and infinite values are clamped to 0 and counted.
 pub fn read_image_with_limits(path: &Path, limits: &Limits) -> Result<LoadedImage, IoError> {
     let format = format_of(path)?;
-    let bytes = std::fs::read(path).map_err(|e| IoError::read(path, e))?;
+    let bytes = read_bounded(path, limits.max_file_bytes())?;
     let raw = decode(format, &bytes, limits).map_err(|e| e.with_path(path))?;
     drop(bytes);
     let mut image = raw.image;

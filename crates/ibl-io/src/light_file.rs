@@ -186,6 +186,8 @@ pub fn sha256_file(path: &Path) -> Result<String, IoError> {
         path: path.to_path_buf(),
         source,
     };
+    // Streamed, so no size bound; but a device or a FIFO would never end: regular files only.
+    crate::check_regular(path, &std::fs::metadata(path).map_err(io)?)?;
     let mut file = std::fs::File::open(path).map_err(io)?;
     let mut hasher = Sha256::new();
     let mut buf = vec![0u8; 1 << 16];

@@ -51,6 +51,24 @@ fn token<'a>(bytes: &'a [u8], pos: &mut usize, what: &str) -> Result<&'a str, De
         .map_err(|_| DecodeError::invalid(format!("header {what} is not text")))
 }
 
+/// The image size (width, height) a PFM header announces, from the header alone (`bytes` may be
+/// only the start of the file).
+pub fn header_size(bytes: &[u8]) -> Result<(usize, usize), DecodeError> {
+    if !matches!(bytes.get(..2), Some(b"PF" | b"Pf"))
+        || !bytes.get(2).is_some_and(u8::is_ascii_whitespace)
+    {
+        return Err(wrong_magic("a PFM file (\"PF\" or \"Pf\")", bytes));
+    }
+    let mut pos = 2;
+    let mut size = |what: &str| {
+        let t = token(bytes, &mut pos, what)?;
+        t.parse::<usize>()
+            .map_err(|_| DecodeError::invalid(format!("bad {what} {t:?}")))
+    };
+    let width = size("width")?;
+    Ok((width, size("height")?))
+}
+
 /// Decodes a PFM file held in memory (values exactly as stored, not sanitised).
 pub fn decode(bytes: &[u8], limits: &Limits) -> Result<RawImage, DecodeError> {
     let channels = match bytes.get(..2) {

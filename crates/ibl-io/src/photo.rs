@@ -58,8 +58,9 @@ pub fn exif_exposure_time(bytes: &[u8]) -> Option<f64> {
 
 /// Reads a photograph's codes and EXIF exposure time.
 pub fn read_photo(path: &Path) -> Result<Photo, IoError> {
-    let bytes = std::fs::read(path).map_err(|e| IoError::read(path, e))?;
-    let codes = decode_codes(&bytes, &Limits::default()).map_err(|e| e.with_path(path))?;
+    let limits = Limits::default();
+    let bytes = crate::read_bounded(path, limits.max_file_bytes())?;
+    let codes = decode_codes(&bytes, &limits).map_err(|e| e.with_path(path))?;
     let exposure_time_s = exif_exposure_time(&bytes);
     let details = match exposure_time_s {
         Some(t) => format!("8-bit codes, EXIF exposure {t} s"),

@@ -9,7 +9,9 @@
 use std::path::{Path, PathBuf};
 
 use ibl_core::{Image, Rgb};
-use ibl_scene::description::{BackgroundKind, GeometryDescription, ShapeKind};
+use ibl_scene::description::{
+    BackgroundKind, GeometryDescription, MAX_SCENE_TRIANGLES, ShapeKind, shape_triangles,
+};
 use ibl_scene::{MeshAsset, Scene, SceneDescription};
 
 use crate::IoError;
@@ -48,15 +50,17 @@ pub fn parse_scene(path: &Path, text: &str) -> Result<SceneDescription, IoError>
 
 /// The meshes of `entries` (the `table` entries of the file `path`: a scene's `local` or
 /// `object`, an edits file's `object`), files relative to `path`'s folder: one entry per
-/// description, `None` for shapes; with the files read. Errors name `path`, the field and the
-/// mesh file.
+/// description, `None` for shapes; with the files read. `triangles_left` is what the scene's
+/// triangle limit ([`ibl_scene::description::MAX_SCENE_TRIANGLES`]) leaves: each file is read
+/// with it as its limit (so no file's geometry is allocated past it) and its triangles are taken
+/// from it. Errors name `path`, the field and the mesh file.
 pub fn read_meshes(
     path: &Path,
     table: &str,
     entries: &[GeometryDescription],
+    triangles_left: &mut usize,
 ) -> Result<(Vec<Option<MeshAsset>>, Vec<PathBuf>), IoError> {
     let folder = path.parent().unwrap_or(Path::new("."));
-    let limits = MeshLimits::default();
     let mut files = Vec::new();
     let meshes = entries
         .iter()
@@ -64,8 +68,30 @@ pub fn read_meshes(
         .map(|(i, entry)| match (entry.shape, &entry.file) {
             (ShapeKind::Mesh, Some(file)) => {
                 let p = folder.join(file);
-                let loaded = read_mesh(&p, &limits)
-                    .map_err(|e| asset_error(path, &format!("{table}[{i}].file"), e))?;
+                let field = format!("{table}[{i}].file");
+                let defaults = MeshLimits::default();
+                let limits = MeshLimits {
+                    max_triangles: defaults.max_triangles.min(*triangles_left),
+                    ..defaults
+                };
+                let loaded = read_mesh(&p, &limits).map_err(|e| {
+                    let e = match e {
+                        IoError::Limits { path, what }
+                            if limits.max_triangles < defaults.max_triangles =>
+                        {
+                            IoError::Limits {
+                                path,
+                                what: format!(
+                                    "{what} (what the scene's limit of {MAX_SCENE_TRIANGLES} \
+                                     triangles leaves after the entries before it)"
+                                ),
+                            }
+                        }
+                        other => other,
+                    };
+                    asset_error(path, &field, e)
+                })?;
+                *triangles_left = triangles_left.saturating_sub(loaded.mesh.triangle_count());
                 files.push(p);
                 Ok(Some(MeshAsset {
                     mesh: loaded.mesh,
@@ -93,17 +119,7 @@ fn asset_error(path: &Path, field: &str, e: IoError) -> IoError {
 
 /// Reads a scene file and everything it names.
 pub fn read_scene(path: &Path) -> Result<LoadedScene, IoError> {
-    let size = std::fs::metadata(path)
-        .map_err(|e| IoError::read(path, e))?
-        .len();
-    if size > MAX_SCENE_BYTES {
-        return Err(IoError::Limits {
-            path: path.to_path_buf(),
-            what: format!("{size} bytes (a scene file is at most {MAX_SCENE_BYTES})"),
-        });
-    }
-    let bytes = std::fs::read(path).map_err(|e| IoError::read(path, e))?;
-    let text = String::from_utf8(bytes).map_err(|_| invalid(path, "not UTF-8 text"))?;
+    let text = crate::read_text(path, MAX_SCENE_BYTES)?;
     let description = parse_scene(path, &text)?;
     let folder = path.parent().unwrap_or(Path::new("."));
     let resolve = |p: &Path| folder.join(p);
@@ -139,8 +155,12 @@ pub fn read_scene(path: &Path) -> Result<LoadedScene, IoError> {
             _ => None,
         };
 
-    let (local, local_paths) = read_meshes(path, "local", &description.local)?;
-    let (objects, object_paths) = read_meshes(path, "object", &description.object)?;
+    // Validation has checked that the shapes alone are within the limit.
+    let mut triangles_left = MAX_SCENE_TRIANGLES
+        .saturating_sub(shape_triangles(&description.local) + shape_triangles(&description.object));
+    let (local, local_paths) = read_meshes(path, "local", &description.local, &mut triangles_left)?;
+    let (objects, object_paths) =
+        read_meshes(path, "object", &description.object, &mut triangles_left)?;
     inputs.extend(local_paths);
     inputs.extend(object_paths);
     let lights_path = description.lighting.lights_file.as_deref().map(resolve);

@@ -404,18 +404,7 @@ pub fn parse_sh(format: ShFileFormat, text: &str) -> Result<ShFile, String> {
 
 /// Reads an SH file (at most 4 MiB) in `format`.
 pub fn read_sh_file(path: &Path, format: ShFileFormat) -> Result<ShFile, IoError> {
-    let io = |source| IoError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
-    let size = std::fs::metadata(path).map_err(io)?.len();
-    if size > MAX_SH_FILE_BYTES {
-        return Err(IoError::Limits {
-            path: path.to_path_buf(),
-            what: format!("{size} bytes; SH files are at most {MAX_SH_FILE_BYTES}"),
-        });
-    }
-    let text = std::fs::read_to_string(path).map_err(io)?;
+    let text = crate::read_text(path, MAX_SH_FILE_BYTES)?;
     parse_sh(format, &text).map_err(|reason| IoError::Invalid {
         path: path.to_path_buf(),
         reason: format!("{} SH file: {reason}", format.name()),

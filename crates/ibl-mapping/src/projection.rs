@@ -258,11 +258,19 @@ impl Projection {
                 } else {
                     w
                 };
+                // Each cell's top-left quadrant once (a quarter of the exact integrals), then
+                // every texel read from it.
+                let (qw, qh) = (cw.div_ceil(2), h.div_ceil(2));
+                let cells = w / cw.max(1);
+                let quadrants = Image::from_fn_par(qw * cells, qh, |qi, j| {
+                    let (cell, li) = (qi / qw, qi % qw);
+                    self.texel_solid_angle(cell * cw + li, j)
+                });
                 Image::from_fn_par(w, h, |i, j| {
-                    let (x0, li) = (i - i % cw, i % cw);
+                    let (cell, li) = (i / cw, i % cw);
                     let li = li.min(cw - 1 - li);
                     let lj = j.min(h - 1 - j);
-                    self.texel_solid_angle(x0 + li, lj)
+                    *quadrants.get(cell * qw + li, lj)
                 })
             }
             _ => Image::from_fn_par(w, h, |i, j| self.texel_solid_angle(i, j)),

@@ -109,6 +109,8 @@ pub fn unwrap_balls(job: &BallJob) -> Result<BallSummary> {
     for out in &outputs {
         crate::output_paths::check_output_path(out, &inputs)?;
     }
+    let what = format!("--width {}", job.width);
+    crate::output_paths::check_output_pixels(&what, job.width, job.width / 2)?;
     let mut views = Vec::new();
     let mut summary = Vec::new();
     let mut reliability_maps = Vec::new();
@@ -200,6 +202,8 @@ pub fn stitch_fisheyes(job: &FisheyeJob) -> Result<Stitched> {
     for out in &outputs {
         crate::output_paths::check_output_path(out, &inputs)?;
     }
+    let what = format!("--width {}", job.width);
+    crate::output_paths::check_output_pixels(&what, job.width, job.width / 2)?;
     let front = ibl_io::read_image(&job.front)?.image;
     let back = match &job.back {
         Some(p) => Some(ibl_io::read_image(p)?.image),

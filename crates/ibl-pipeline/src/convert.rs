@@ -178,6 +178,12 @@ pub fn convert(o: &ConvertOptions, progress: &dyn Progress) -> Result<Converted>
     let to = o.to.or(o.from).unwrap_or(EnvMapping::Single(env.mapping));
     let to_mapping = to.in_memory();
     let (w, h) = output_size(o, to, &env)?;
+    let asked = match (o.face_size, o.width) {
+        (Some(s), _) => format!("--face-size {s}"),
+        (None, Some(w)) => format!("--width {w}"),
+        (None, None) => format!("{} at the input's resolution", to.name()),
+    };
+    crate::output_paths::check_output_pixels(&asked, w, h)?;
     let world_rotation: Mat3 = o.frame.world_from_latlong_image().transpose()
         * o.rotation.world_from_probe()
         * o.from_frame.world_from_latlong_image();

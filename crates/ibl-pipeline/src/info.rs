@@ -43,6 +43,51 @@ pub fn probe_info(path: &Path, mapping: Option<EnvMapping>, frame: FramePreset) 
     ))
 }
 
+/// What `ibl info --header` reports: the header's facts, no pixel decoded.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct HeaderInfo {
+    /// The file described.
+    pub file: String,
+    /// File format (`hdr`, `exr`, `pfm`, `png`, `jpeg`, `ktx2`, `dds`).
+    pub format: String,
+    /// Width in pixels.
+    pub width: usize,
+    /// Height in pixels.
+    pub height: usize,
+    /// `width * height`.
+    pub pixels: u64,
+    /// Whether [`ibl_io::Limits::default`] would decode it (2^28 pixels unless `--max-pixels`
+    /// or `IBL_MAX_PIXELS` set another limit).
+    pub within_limits: bool,
+    /// The mapping given, or guessed from the shape ([`UNKNOWN_MAPPING`] when it names none).
+    pub mapping: String,
+    /// Whether the mapping was guessed from the shape.
+    pub mapping_guessed: bool,
+}
+
+/// Reads only `path`'s header (`ibl_io::read_header`): instant whatever the image's size, and
+/// nothing allocated for its pixels.
+pub fn header_info(path: &Path, mapping: Option<EnvMapping>) -> Result<HeaderInfo> {
+    let limits = ibl_io::Limits::default();
+    let h = ibl_io::read_header(path, &limits)?;
+    let guessed = Mapping::detect_from_shape(h.width, h.height);
+    let (mapping, mapping_guessed) = match (mapping, guessed) {
+        (Some(m), _) => (m.name(), false),
+        (None, Some(g)) => (g.name(), true),
+        (None, None) => (UNKNOWN_MAPPING.to_string(), false),
+    };
+    Ok(HeaderInfo {
+        file: path.display().to_string(),
+        format: h.format.name().to_string(),
+        width: h.width,
+        height: h.height,
+        pixels: h.width as u64 * h.height as u64,
+        within_limits: limits.check(h.width as u64, h.height as u64).is_ok(),
+        mapping,
+        mapping_guessed,
+    })
+}
+
 /// Describes an image whose shape names no mapping: statistics over every pixel, no power and
 /// no direction (those need a mapping: `--mapping` gives one).
 fn describe_unmapped(loaded: &LoadedImage, frame: FramePreset, file: &str) -> Info {

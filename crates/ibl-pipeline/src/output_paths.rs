@@ -42,6 +42,26 @@ pub fn check_output_path(output: &Path, inputs: &[&Path]) -> Result<()> {
         .map_err(|e| PipelineError::parameter(format!("{shown}: cannot write there: {e}")))
 }
 
+/// Refuses an output image of `width x height` pixels (`what` names it, e.g. `--width 30000`)
+/// that the readers would refuse: over [`ibl_io::Limits::default`]'s width, height or pixel count
+/// (2^28 pixels unless `--max-pixels` or `IBL_MAX_PIXELS` set another). Called before any work,
+/// so a mistyped width fails at once instead of after minutes and gigabytes.
+pub fn check_output_pixels(what: &str, width: usize, height: usize) -> Result<()> {
+    let limits = ibl_io::Limits::default();
+    let pixels = width.checked_mul(height);
+    let fits = width <= limits.max_width
+        && height <= limits.max_height
+        && pixels.is_some_and(|p| p <= limits.max_pixels);
+    if fits {
+        return Ok(());
+    }
+    Err(PipelineError::parameter(format!(
+        "{what}: the output would be {width} x {height} pixels, over the limit of {} pixels \
+         ({} x {} at most; --max-pixels or IBL_MAX_PIXELS sets the pixel limit)",
+        limits.max_pixels, limits.max_width, limits.max_height
+    )))
+}
+
 /// Checks that `folder` (an existing folder) takes a new file, by creating and removing one.
 pub fn check_folder_takes_files(folder: &Path) -> std::io::Result<()> {
     let probe = folder.join(format!(".iblkit-check-{}", std::process::id()));

@@ -11,7 +11,6 @@
 use std::path::{Path, PathBuf};
 
 use ibl_core::{Image, Rgb};
-use ibl_io::IoError;
 use ibl_room::{AnalysisSettings, MarksFile, Room, RoomAnalysis, RoomFile, Stage, analyse_room};
 
 use crate::error::{Context, PipelineError, Result};
@@ -22,26 +21,7 @@ pub const MAX_ROOM_TEXT_BYTES: u64 = 16 << 20;
 
 /// Reads a text file of at most [`MAX_ROOM_TEXT_BYTES`].
 fn read_text(path: &Path) -> Result<String> {
-    let io = |source| IoError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
-    let len = std::fs::metadata(path).map_err(io)?.len();
-    if len > MAX_ROOM_TEXT_BYTES {
-        return Err(IoError::Limits {
-            path: path.to_path_buf(),
-            what: format!("{len} bytes (at most {MAX_ROOM_TEXT_BYTES})"),
-        }
-        .into());
-    }
-    let bytes = std::fs::read(path).map_err(io)?;
-    String::from_utf8(bytes).map_err(|_| {
-        IoError::Invalid {
-            path: path.to_path_buf(),
-            reason: "not UTF-8 text".into(),
-        }
-        .into()
-    })
+    Ok(ibl_io::read_text(path, MAX_ROOM_TEXT_BYTES)?)
 }
 
 /// A marks file, parsed and validated.

@@ -363,7 +363,10 @@ impl RoomEdits {
         let objects = if self.objects.is_empty() {
             None
         } else {
-            let (meshes, _) = ibl_io::read_meshes(&self.source, "object", &self.objects)?;
+            let mut triangles_left = ibl_scene::description::MAX_SCENE_TRIANGLES
+                .saturating_sub(ibl_scene::description::shape_triangles(&self.objects));
+            let (meshes, _) =
+                ibl_io::read_meshes(&self.source, "object", &self.objects, &mut triangles_left)?;
             let layer = ibl_scene::virtual_layer(&self.objects, meshes)
                 .map_err(|e| PipelineError::parameter(format!("{}: {e}", self.source.display())))?;
             Some(layer)

@@ -18,8 +18,7 @@ use crate::patch::PatchAttributes;
 use crate::ray::gamma;
 use crate::{Bvh, Camera, Hit, Material, TriangleMesh, primitives};
 
-/// Icosphere subdivisions of a `sphere` shape (20480 triangles).
-pub const SPHERE_SUBDIVISIONS: u32 = 5;
+pub use crate::description::SPHERE_SUBDIVISIONS;
 
 /// Shading data of one triangle of a layer.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -71,10 +71,7 @@ impl SceneModel {
     /// Reads a scene file and everything it names (`ibl_io::read_scene`).
     pub fn open(path: &Path) -> Result<SceneModel, ViewerError> {
         let loaded = ibl_io::read_scene(path)?;
-        let text = std::fs::read_to_string(path).map_err(|source| ibl_io::IoError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let text = ibl_io::read_text(path, ibl_io::scene_file::MAX_SCENE_BYTES)?;
         let geometry = SceneGeometry::from_scene(&loaded.scene);
         let given_lights = match &loaded.lights_path {
             Some(file) => Some(

@@ -303,6 +303,19 @@ fn text(name: &str) -> Result<x::Text, DecodeError> {
 /// file with repeated attributes can make our own header parse and `exr`'s disagree, so the
 /// checks in [`check_file_size`] are repeated here on `exr`'s view): each uncompressed block at
 /// most [`MAX_BLOCK_BYTES`], and an offset table that fits in the file.
+/// The size (width, height) of the first part's data window, from the header alone (no pixel is
+/// decoded; `bytes` may be only the start of the file).
+pub fn header_size(bytes: &[u8]) -> Result<(usize, usize), DecodeError> {
+    let parsed = header::parse(bytes)?;
+    let window = parsed
+        .parts
+        .first()
+        .and_then(|p| p.data_window)
+        .ok_or_else(|| DecodeError::invalid("no dataWindow in the header"))?;
+    let size = |v: i64| usize::try_from(v).map_err(|_| DecodeError::invalid("empty dataWindow"));
+    Ok((size(window.width())?, size(window.height())?))
+}
+
 fn check_parsed_headers(
     headers: &[::exr::meta::header::Header],
     len: usize,

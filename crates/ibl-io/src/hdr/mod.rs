@@ -150,6 +150,13 @@ fn parse_layout(line: &[u8]) -> Result<Layout, DecodeError> {
     })
 }
 
+/// The image size (width, height) a Radiance header announces, from the header alone (no pixel
+/// is decoded; `bytes` may be only the start of the file).
+pub fn header_size(bytes: &[u8]) -> Result<(usize, usize), DecodeError> {
+    let layout = parse_header(bytes)?.layout;
+    Ok((layout.width, layout.height))
+}
+
 fn parse_header(bytes: &[u8]) -> Result<Header, DecodeError> {
     if !bytes.starts_with(b"#?") {
         return Err(wrong_magic("a Radiance HDR file (\"#?RADIANCE\")", bytes));

@@ -302,23 +302,19 @@ impl<'a> Buffers<'a> {
         let relative = percent_decode(uri)
             .ok_or_else(|| DecodeError::invalid(format!("buffer {index}: bad uri {uri:?}")))?;
         let file = dir.join(relative);
-        let cannot = |e: std::io::Error| {
-            DecodeError::invalid(format!(
-                "buffer {index}: cannot read {}: {e}",
-                file.display()
-            ))
-        };
-        let len = std::fs::metadata(&file).map_err(cannot)?.len();
-        if len > self.external_budget {
-            return Err(DecodeError::Limits(format!(
-                "buffer {index} ({}) has {len} bytes, over the {} bytes the file size limit \
-                 leaves for external buffers",
+        // Bounded by what the file size limit leaves, whatever the file is (a device, a FIFO
+        // and a directory are refused by type).
+        let bytes = crate::read_bounded(&file, self.external_budget).map_err(|e| match e {
+            crate::IoError::Limits { .. } => DecodeError::Limits(format!(
+                "buffer {index} ({}) is over the {} bytes the file size limit leaves for \
+                 external buffers",
                 file.display(),
                 self.external_budget
-            )));
-        }
-        self.external_budget -= len;
-        std::fs::read(&file).map(Cow::Owned).map_err(cannot)
+            )),
+            other => DecodeError::invalid(format!("buffer {index}: cannot read {other}")),
+        })?;
+        self.external_budget -= bytes.len() as u64;
+        Ok(Cow::Owned(bytes))
     }
 }
 

@@ -71,12 +71,23 @@ pub(super) fn read_obj(
             library.split_whitespace().map(|f| dir.join(f)).collect()
         };
         for file in files {
-            if !file.is_file() {
+            // A missing library is common (an OBJ copied without its .mtl): a note. One that
+            // exists but is not a regular file, or is the OBJ itself, is an error.
+            if std::fs::symlink_metadata(&file).is_err() {
                 parsed.notes.push(format!(
                     "material library {} not found, default base colours",
                     file.display()
                 ));
                 continue;
+            }
+            if same_file(&file, path) {
+                return Err(IoError::Invalid {
+                    path: path.to_path_buf(),
+                    reason: format!(
+                        "mtllib {} names the OBJ file itself, not a material library",
+                        file.display()
+                    ),
+                });
             }
             let text = crate::read_bounded(&file, limits.max_file_bytes)?;
             let found = parse_mtl(&text).map_err(|e| e.with_path(&file))?;
@@ -85,6 +96,12 @@ pub(super) fn read_obj(
     }
     let base_colors = base_colors_of(&parsed.mesh.material_names, &colors);
     finish(parsed.mesh, base_colors, "Wavefront OBJ", parsed.notes).map_err(|e| e.with_path(path))
+}
+
+/// Whether two paths name the same file (canonical paths equal); false when either cannot be
+/// resolved.
+fn same_file(a: &Path, b: &Path) -> bool {
+    matches!((a.canonicalize(), b.canonicalize()), (Ok(x), Ok(y)) if x == y)
 }
 
 fn base_colors_of(names: &[String], colors: &HashMap<String, Rgb>) -> Vec<Rgb> {

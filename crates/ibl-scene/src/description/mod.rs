@@ -42,7 +42,10 @@ pub use camera::CameraDescription;
 pub use field::DescriptionError;
 use field::invalid;
 pub(crate) use geometry::Layer;
-pub use geometry::{GeometryDescription, Scale, ShapeKind};
+pub use geometry::{
+    GeometryDescription, MAX_SCENE_TRIANGLES, SPHERE_SUBDIVISIONS, Scale, ShapeKind,
+    shape_triangles,
+};
 pub use lighting::{LightingDescription, ShadowKind};
 pub use luminaire::{IntensityScale, LuminaireDescription, MAX_LUMINAIRES, validate_luminaires};
 pub use material::{
@@ -202,6 +205,19 @@ impl SceneDescription {
         }
         for (i, g) in self.object.iter().enumerate() {
             g.validate(&format!("object[{i}]"), Layer::Virtual)?;
+        }
+        let shapes = shape_triangles(&self.local) + shape_triangles(&self.object);
+        if shapes > MAX_SCENE_TRIANGLES {
+            return Err(invalid(
+                "object",
+                format!(
+                    "the {} [[local]] and [[object]] entries' shapes make {shapes} triangles, over \
+                     the limit of {MAX_SCENE_TRIANGLES} for a whole scene (a sphere is {} \
+                     triangles)",
+                    self.local.len() + self.object.len(),
+                    ShapeKind::Sphere.triangle_count().unwrap_or(0)
+                ),
+            ));
         }
         self.render.validate()?;
         self.lighting.validate()?;
