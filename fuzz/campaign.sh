@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # Fuzz each named target for SECONDS of wall time on one core (one libFuzzer process), one after
-# the other, and append a line per run to fuzz/campaign.log: the date, the target, the seconds,
-# libFuzzer's executions, coverage and features, and the corpus's size after the run. Crashes
-# stop the run and are left in fuzz/artifacts/<target>/.
+# the other, and append a line per run to fuzz/campaign.log: the date, the commit, the target,
+# the wall and CPU seconds (user + system, measured: a niced run on a busy machine gets less CPU
+# than wall time, so CPU-hours are summed from this column), libFuzzer's executions, coverage
+# and features, and the corpus's size after the run. Crashes stop the run and are left in
+# fuzz/artifacts/<target>/. Runs resume from the corpus, so short runs add up.
 #
 # Usage (from the repository root, after `bash fuzz/seed.sh`):
 #   RUSTC_BOOTSTRAP=1 bash fuzz/campaign.sh 3600 hdr exr      # one CPU-hour each
@@ -16,15 +18,18 @@ for t in "$@"; do
   mkdir -p "fuzz/corpus/$t" "fuzz/artifacts/$t"
   out=$(mktemp)
   start=$(date -u +%Y-%m-%dT%H:%MZ)
-  nice -n 10 cargo fuzz run -O "$t" -- -max_total_time="$secs" -rss_limit_mb=4096 -timeout=30 \
-    -print_final_stats=1 >"$out" 2>&1
+  cpu=$(mktemp)
+  /usr/bin/time -f "%U %S" -o "$cpu" nice -n 10 cargo fuzz run -O "$t" -- \
+    -max_total_time="$secs" -rss_limit_mb=4096 -timeout=30 -print_final_stats=1 >"$out" 2>&1
   rc=$?
-  done_line=$(grep -E '^#[0-9]+ +DONE' "$out" | tail -1)
+  cpu_s=$(awk 'END {printf "%.0f", $1 + $2}' "$cpu")
+  rm -f "$cpu"
+  done_line=$(grep -E '^#[0-9]+[[:space:]]+DONE' "$out" | tail -1)
   execs=$(grep -E '^stat::number_of_executed_units' "$out" | awk '{print $2}')
   files=$(find "fuzz/corpus/$t" -type f | wc -l)
   bytes=$(du -sb "fuzz/corpus/$t" | cut -f1)
   crashes=$(find "fuzz/artifacts/$t" -type f | wc -l)
-  echo "$start $commit $t ${secs}s rc=$rc execs=${execs:-?} corpus=${files}files/${bytes}B artifacts=$crashes | ${done_line:-no DONE line}" | tee -a "$log"
+  echo "$start $commit $t wall=${secs}s cpu=${cpu_s}s rc=$rc execs=${execs:-?} corpus=${files}files/${bytes}B artifacts=$crashes | ${done_line:-no DONE line}" | tee -a "$log"
   [ "$rc" -eq 0 ] || tail -40 "$out" >"fuzz/artifacts/$t/last-run.txt"
   rm -f "$out"
 done

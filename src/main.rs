@@ -9,6 +9,7 @@ mod cmd;
 mod failure;
 mod probe_arg;
 mod progress;
+mod signals;
 mod values;
 
 use std::process::ExitCode;
@@ -86,6 +87,7 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    signals::install();
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => {

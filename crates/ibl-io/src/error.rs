@@ -62,9 +62,10 @@ impl IoError {
     /// missing input file, or an output naming an input) rather than an internal failure.
     ///
     /// True for [`IoError::Invalid`], [`IoError::Unsupported`], [`IoError::Limits`],
-    /// [`IoError::SameAsInput`], and for [`IoError::Io`] errors of kind `NotFound`,
-    /// `PermissionDenied` or `IsADirectory` raised while *reading*; false for any other I/O
-    /// error, including every error raised while writing an output.
+    /// [`IoError::SameAsInput`], for [`IoError::Io`] errors of kind `NotFound`,
+    /// `PermissionDenied` or `IsADirectory` raised while *reading*, and for errors raised while
+    /// *writing* that the output's place causes (the user's path: a missing, read-only or full
+    /// folder, see [`is_destination_fault`]); false for any other I/O error.
     pub fn is_bad_input(&self) -> bool {
         match self {
             IoError::Invalid { .. }
@@ -75,13 +76,16 @@ impl IoError {
                 let while_writing = source
                     .get_ref()
                     .is_some_and(|inner| inner.is::<WriteFailure>());
-                !while_writing
-                    && matches!(
+                if while_writing {
+                    is_destination_fault(source.kind())
+                } else {
+                    matches!(
                         source.kind(),
                         io::ErrorKind::NotFound
                             | io::ErrorKind::PermissionDenied
                             | io::ErrorKind::IsADirectory
                     )
+                }
             }
         }
     }
@@ -103,6 +107,25 @@ impl IoError {
             source: io::Error::new(kind, WriteFailure(source)),
         }
     }
+}
+
+/// Whether a write failed because of where the user asked it to go (exit status 2): the folder
+/// is missing or not a folder, refuses writes (permissions, a read-only file system), or is full
+/// (no space, over quota, a file too large for it). Other write failures are internal (1).
+pub fn is_destination_fault(kind: io::ErrorKind) -> bool {
+    use io::ErrorKind as K;
+    matches!(
+        kind,
+        K::NotFound
+            | K::PermissionDenied
+            | K::IsADirectory
+            | K::NotADirectory
+            | K::ReadOnlyFilesystem
+            | K::StorageFull
+            | K::QuotaExceeded
+            | K::FileTooLarge
+            | K::InvalidFilename
+    )
 }
 
 /// Marks an `io::Error` raised while writing an output (see [`IoError::is_bad_input`]).
@@ -194,7 +217,22 @@ mod tests {
         assert!(IoError::read(p, io::Error::from(io::ErrorKind::NotFound)).is_bad_input());
         assert!(IoError::read(p, io::Error::from(io::ErrorKind::PermissionDenied)).is_bad_input());
         assert!(!IoError::read(p, io::Error::from(io::ErrorKind::OutOfMemory)).is_bad_input());
-        assert!(!IoError::write(p, io::Error::from(io::ErrorKind::NotFound)).is_bad_input());
+        // Issue 13: a missing, read-only or full output folder is the user's path (exit 2);
+        // before, every write error was internal.
+        for kind in [
+            io::ErrorKind::NotFound,
+            io::ErrorKind::PermissionDenied,
+            io::ErrorKind::ReadOnlyFilesystem,
+            io::ErrorKind::StorageFull,
+            io::ErrorKind::QuotaExceeded,
+        ] {
+            assert!(
+                IoError::write(p, io::Error::from(kind)).is_bad_input(),
+                "{kind:?}"
+            );
+        }
+        assert!(!IoError::write(p, io::Error::from(io::ErrorKind::OutOfMemory)).is_bad_input());
+        assert!(!IoError::write(p, io::Error::other("disk on fire")).is_bad_input());
         assert!(!EncodeError::new("x").with_path(p).is_bad_input());
         assert!(DecodeError::invalid("x").with_path(p).is_bad_input());
         assert!(IoError::SameAsInput { path: p.into() }.is_bad_input());

@@ -69,7 +69,7 @@ mod tests {
     #[test]
     fn every_format_reports_the_size_its_decoder_would() {
         let dir = tempfile::tempdir().unwrap();
-        let image = Image::from_fn(12, 5, |x, y| Rgb::new(x as f32, y as f32, 1.0));
+        let image = Image::from_fn_par(12, 5, |x, y| Rgb::new(x as f32, y as f32, 1.0));
         for ext in ["hdr", "exr", "pfm", "png", "jpg", "ktx2", "dds"] {
             let p = dir.path().join(format!("a.{ext}"));
             crate::write_image(&p, &image, &crate::WriteOptions::default()).unwrap();

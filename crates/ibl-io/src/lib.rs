@@ -41,6 +41,7 @@ pub mod sanitize;
 pub mod scene_file;
 pub mod scene_write;
 pub mod sh_file;
+pub mod temp_files;
 pub mod texture;
 
 use std::io::Write;
@@ -309,18 +310,22 @@ pub fn write_image(path: &Path, image: &Image<Rgb>, options: &WriteOptions) -> R
 }
 
 /// Writes `bytes` to `path` through a temporary file in the same directory, synced, then renamed
-/// over `path` (mode 0644 on Unix); also useful for non-image outputs such as JSON.
+/// over `path` (mode 0644 on Unix); also useful for non-image outputs such as JSON. The temporary
+/// file is named and listed as [`temp_files`] says, so an interrupt removes it and a later run
+/// cleans what a `kill -9` left.
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), IoError> {
     let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
     };
     let err = |e| IoError::write(path, e);
+    temp_files::clean_stale_in(dir);
     let mut tmp = tempfile::Builder::new()
-        .prefix(".iblkit-")
+        .prefix(&temp_files::temp_prefix())
         .suffix(".tmp")
         .tempfile_in(dir)
         .map_err(err)?;
+    let _listed = temp_files::TempRegistration::new(tmp.path());
     tmp.write_all(bytes).map_err(err)?;
     #[cfg(unix)]
     {

@@ -235,8 +235,9 @@ fn errors_name_the_file_and_are_classified() {
         &WriteOptions::default(),
     )
     .expect_err("no directory");
+    // The user's path: bad input (exit 2), issue 13.
     assert!(
-        matches!(err, IoError::Io { .. }) && !err.is_bad_input(),
+        matches!(err, IoError::Io { .. }) && err.is_bad_input(),
         "{err}"
     );
     assert!(

@@ -195,6 +195,8 @@ impl Drop for VideoReader {
 pub struct VideoWriter {
     path: PathBuf,
     temporary: PathBuf,
+    /// Lists the temporary file for removal on an interrupt (`ibl_io::temp_files`).
+    _listed: ibl_io::temp_files::TempRegistration,
     child: Child,
     stdin: Option<ChildStdin>,
     size: (usize, usize),
@@ -211,7 +213,9 @@ impl VideoWriter {
             .file_name()
             .map(|n| n.to_string_lossy().into_owned())
             .unwrap_or_else(|| "video.mp4".into());
-        let temporary = folder.join(format!(".iblkit-{}-{name}", std::process::id()));
+        ibl_io::temp_files::clean_stale_in(&folder);
+        let temporary = folder.join(format!("{}{name}", ibl_io::temp_files::temp_prefix()));
+        let listed = ibl_io::temp_files::TempRegistration::new(&temporary);
         let mut child = Command::new("ffmpeg")
             .args([
                 "-v", "error", "-nostdin", "-y", "-f", "rawvideo", "-pix_fmt", "rgb24",
@@ -234,6 +238,7 @@ impl VideoWriter {
         Ok(VideoWriter {
             path: path.to_path_buf(),
             temporary,
+            _listed: listed,
             child,
             stdin,
             size,
