@@ -9,7 +9,6 @@ mod cmd;
 mod failure;
 mod probe_arg;
 mod progress;
-mod signals;
 mod values;
 
 use std::process::ExitCode;
@@ -87,7 +86,7 @@ enum Command {
 }
 
 fn main() -> ExitCode {
-    signals::install();
+    ibl_pipeline::interrupts::install();
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => {

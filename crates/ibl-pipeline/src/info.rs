@@ -319,3 +319,91 @@ fn channel_stats(img: &Image<Rgb>, solid: &Image<f64>) -> ChannelStats {
     }
     s
 }
+
+/// The text `ibl info` prints.
+impl std::fmt::Display for Info {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let i = self;
+        let guessed = if i.mapping_guessed {
+            " (guessed from shape; --mapping to override)"
+        } else if i.mapping == UNKNOWN_MAPPING {
+            " (its shape names none: not read as a probe; --mapping to name one)"
+        } else {
+            ""
+        };
+        writeln!(f, "file        {}", i.file)?;
+        writeln!(f, "format      {} ({})", i.format, i.encoding)?;
+        writeln!(f, "size        {} x {}", i.width, i.height)?;
+        writeln!(f, "mapping     {}{guessed}", i.mapping)?;
+        writeln!(f, "             {:>12} {:>12} {:>12}", "R", "G", "B")?;
+        for (name, v) in [("min", i.min), ("max", i.max)] {
+            writeln!(
+                f,
+                "{name:<12}{:>12.5e} {:>12.5e} {:>12.5e}",
+                v[0], v[1], v[2]
+            )?;
+        }
+        let m = i.mean;
+        writeln!(
+            f,
+            "mean        {:>12.5e} {:>12.5e} {:>12.5e}",
+            m[0], m[1], m[2]
+        )?;
+        match i.power {
+            Some(p) => writeln!(
+                f,
+                "power       {:>12.5e} {:>12.5e} {:>12.5e}   (sum L dOmega)",
+                p[0], p[1], p[2]
+            )?,
+            None => writeln!(f, "power       needs a mapping: name one with --mapping")?,
+        }
+        let dr = &i.dynamic_range;
+        writeln!(
+            f,
+            "range       luminance {:.3e} .. {:.3e}: {:.3e}:1 ({:.1} stops)",
+            dr.min_positive_luminance, dr.max_luminance, dr.ratio, dr.stops
+        )?;
+        writeln!(
+            f,
+            "invalid     {} negative, {} NaN/Inf values (clamped to 0; raw min {:.4e} {:.4e} {:.4e})",
+            i.negative_values, i.nonfinite_values, i.raw_min[0], i.raw_min[1], i.raw_min[2]
+        )?;
+        let b = &i.brightest;
+        let direction = match b.direction {
+            Some(d) => format!(
+                "direction ({:+.4}, {:+.4}, {:+.4}) [{} axes], ",
+                d[0], d[1], d[2], i.frame
+            ),
+            None => String::new(),
+        };
+        writeln!(
+            f,
+            "brightest   {direction}pixel ({}, {}), radiance ({:.4e}, {:.4e}, {:.4e})",
+            b.pixel[0], b.pixel[1], b.radiance[0], b.radiance[1], b.radiance[2]
+        )
+    }
+}
+
+/// The text `ibl info --header` prints.
+impl std::fmt::Display for HeaderInfo {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let guessed = if self.mapping_guessed {
+            " (guessed from shape)"
+        } else {
+            ""
+        };
+        let limits = if self.within_limits {
+            "within the limits"
+        } else {
+            "over the pixel limit: refused unless --max-pixels allows it"
+        };
+        writeln!(f, "file        {}", self.file)?;
+        writeln!(f, "format      {}", self.format)?;
+        writeln!(
+            f,
+            "size        {} x {} ({} pixels, {limits})",
+            self.width, self.height, self.pixels
+        )?;
+        writeln!(f, "mapping     {}{guessed}", self.mapping)
+    }
+}

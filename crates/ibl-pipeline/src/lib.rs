@@ -56,6 +56,7 @@ pub mod error;
 pub mod eval;
 pub mod exposure_list;
 pub mod info;
+pub mod interrupts;
 pub mod irradiance;
 pub mod lighting_plan;
 pub mod lights;

@@ -1,4 +1,5 @@
-//! How the process ends when it is interrupted or its reader goes away.
+//! How a command-line process ends when it is interrupted or its reader goes away; the `ibl`
+//! binary calls [`install`] first thing (a library used from Python leaves signals to Python).
 //!
 //! - **SIGINT, SIGTERM, SIGHUP**: the temporary files of writes in progress are removed
 //!   (`ibl_io::temp_files`), then the signal's default action ends the process (so the shell
@@ -9,7 +10,7 @@
 //!   The panic hook recognises that failure and ends the process quietly with status 141, what a
 //!   process killed by SIGPIPE reports, as other command-line tools do.
 
-/// Installs the handlers; call once, first thing in `main`.
+/// Installs the handlers; call once, first thing in a binary's `main`.
 pub fn install() {
     #[cfg(unix)]
     remove_temporary_files_on_signals();
