@@ -11,7 +11,7 @@ ibl=${1:-target/release/ibl}
 c=fuzz/corpus
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-mkdir -p "$c"/{hdr,pfm,exr,mesh_glb,mesh_obj,room_marks,room_file,scene_file,batch_spec,room_edits,ktx2,dds,ies,ldt}
+mkdir -p "$c"/{hdr,pfm,exr,mesh_glb,mesh_obj,room_marks,room_file,scene_file,batch_spec,room_edits,ktx2,dds,ies,ldt,light_files,sh_file,exposure_times}
 
 # Images: the hostile files and two probes written small in each format.
 for ext in hdr pfm exr; do
@@ -55,6 +55,22 @@ for f in rgba16f rgba32f rgb9e5; do
 done
 cp "$tmp"/*.ktx2 "$c/ktx2/"
 cp "$tmp"/*.dds "$c/dds/"
+
+# Light files: light sets of every method and a hybrid, the room's area lights.
+for m in median-cut lightgen variance-minimization; do
+  "$ibl" lights assets/probes/sky.exr -n 4 --method "$m" -o "$c/light_files/$m.json" >/dev/null
+done
+"$ibl" room lights assets/rooms/apartment/room.toml -n 4 -o "$c/light_files/area.json" >/dev/null
+
+# SH files in every format.
+for f in json threejs filament unity webxr arkit gltf-ext; do
+  "$ibl" sh assets/probes/apartment.exr --format "$f" -o "$c/sh_file/$f.txt" >/dev/null
+done
+
+# Exposure-time lists: plain, OpenCV's list.txt, two columns with a comment.
+printf '1/250, 1/60\n0.25\n' >"$c/exposure_times/plain.txt"
+printf 'a.jpg 0.03125\nb.jpg 0.0625\nIMG_0003.JPG 0.125\n' >"$c/exposure_times/list.txt"
+printf '# name seconds\na.jpg 1/250\nb.jpg 0.25\nIMG_0003.JPG 2\n' >"$c/exposure_times/two.txt"
 
 # Photometry.
 cp assets/photometry/ies/*.ies crates/ibl-io/tests/data/photometry/*.ies "$c/ies/"

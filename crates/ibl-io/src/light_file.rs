@@ -221,7 +221,13 @@ pub fn read_lights_file(path: &Path) -> Result<LightsFile, IoError> {
 /// direction (within 1e-3, renormalised) and finite, non-negative irradiance and solid angle.
 /// The ambient of a hybrid file is not part of a light set and is not returned.
 pub fn read_light_set(path: &Path) -> Result<LightSet, IoError> {
-    let file = read_lights_file(path)?;
+    let bytes = crate::read_bounded(path, MAX_LIGHTS_FILE_BYTES)?;
+    light_set_from_json(path, &bytes)
+}
+
+/// [`read_light_set`] on a file's bytes (`path` names it in errors).
+pub fn light_set_from_json(path: &Path, bytes: &[u8]) -> Result<LightSet, IoError> {
+    let file = LightsFile::from_json(path, bytes)?;
     let world_from_preset = file.frame.world_from_preset().as_dmat3();
     let mut set = file.set.transformed(world_from_preset);
     for (i, l) in set.lights.iter_mut().enumerate() {

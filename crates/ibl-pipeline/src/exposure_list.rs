@@ -80,20 +80,27 @@ pub fn parse_times_file(
     let named = lines
         .first()
         .is_some_and(|t| parse_value(t[0]).is_none() && t.len() == 2);
-    let to_seconds = |v: f64, unit: TimeUnit| match unit {
-        TimeUnit::Seconds => v,
-        TimeUnit::InverseSeconds => 1.0 / v,
+    // A time in seconds, positive and finite: the inverse of a subnormal (`1e-310` in a
+    // `list.txt`) is infinite and refused like any other bad value.
+    let to_seconds = |v: f64, unit: TimeUnit| {
+        let s = match unit {
+            TimeUnit::Seconds => v,
+            TimeUnit::InverseSeconds => 1.0 / v,
+        };
+        (s.is_finite() && s > 0.0).then_some(s)
     };
     if !named {
         let unit = unit.unwrap_or(TimeUnit::Seconds);
         let mut times = Vec::new();
         for token in lines.iter().flatten() {
-            let v = parse_value(token).ok_or_else(|| {
-                PipelineError::parameter(format!(
-                    "{shown}: '{token}' is not a positive exposure time"
-                ))
-            })?;
-            times.push(to_seconds(v, unit));
+            let t = parse_value(token)
+                .and_then(|v| to_seconds(v, unit))
+                .ok_or_else(|| {
+                    PipelineError::parameter(format!(
+                        "{shown}: '{token}' is not a positive exposure time"
+                    ))
+                })?;
+            times.push(t);
         }
         return Ok((times, unit));
     }
@@ -112,12 +119,14 @@ pub fn parse_times_file(
                 tokens.len()
             )));
         };
-        let v = parse_value(value).ok_or_else(|| {
-            PipelineError::parameter(format!(
-                "{shown}: '{value}' ({name}) is not a positive exposure time"
-            ))
-        })?;
-        entries.push((name.to_string(), to_seconds(v, unit)));
+        let t = parse_value(value)
+            .and_then(|v| to_seconds(v, unit))
+            .ok_or_else(|| {
+                PipelineError::parameter(format!(
+                    "{shown}: '{value}' ({name}) is not a positive exposure time"
+                ))
+            })?;
+        entries.push((name.to_string(), t));
     }
     let mut times = Vec::with_capacity(images.len());
     for image in images {
@@ -189,6 +198,25 @@ mod tests {
             (t, unit),
             (vec![1.0 / 250.0, 1.0 / 60.0], TimeUnit::Seconds)
         );
+    }
+
+    #[test]
+    fn an_inverse_time_too_small_to_invert_is_refused() {
+        // Found while writing the `exposure_times` fuzz target: 1 / 1e-310 is infinite, and
+        // was returned as an exposure time.
+        for (text, imgs) in [("a.jpg 1e-310\n", &["a.jpg"][..]), ("1e-310\n", &["a"][..])] {
+            let e = parse_times_file(
+                Path::new("list.txt"),
+                text,
+                &images(imgs),
+                Some(TimeUnit::InverseSeconds),
+            );
+            let message = e.unwrap_err().to_string();
+            assert!(
+                message.contains("not a positive exposure time"),
+                "{message}"
+            );
+        }
     }
 
     #[test]
