@@ -43,7 +43,7 @@ pub use dfg::{Dfg, DfgLayout};
 pub use error::{MappingError, with_article};
 pub use ggx::EngineTarget;
 pub use mapping::{CubeLayout, MAPPING_NAMES, Mapping};
-pub use power::{power, try_power};
+pub use power::{power, power_with_solid_angles, try_power};
 pub use prefilter::{
     DfgOptions, PrefilterOptions, Prefiltered, SpecularChain, SpecularOptions, prefilter,
 };

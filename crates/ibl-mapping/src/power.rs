@@ -23,7 +23,6 @@ pub fn power(image: &Image<Rgb>, mapping: Mapping) -> [f64; 3] {
 /// [`power`], with an error when the image's shape does not fit `mapping`.
 pub fn try_power(image: &Image<Rgb>, mapping: Mapping) -> Result<[f64; 3], MappingError> {
     let projection = Projection::new(mapping, image.width(), image.height())?;
-    let w = image.width();
     let row_sums: Vec<[f64; 3]> = match projection.0 {
         // Lat-long: one solid angle per row, no per-pixel table needed.
         Geometry::LatLong(ll) => (0..image.height())
@@ -31,20 +30,40 @@ pub fn try_power(image: &Image<Rgb>, mapping: Mapping) -> Result<[f64; 3], Mappi
             .map(|j| scale(row_sum(image.row(j), None), ll.row_solid_angle(j)))
             .collect(),
         _ => {
-            let omega = projection.texel_solid_angles();
-            (0..image.height())
-                .into_par_iter()
-                .map(|j| row_sum(image.row(j), Some(&omega.pixels()[j * w..(j + 1) * w])))
-                .collect()
+            return Ok(power_with_solid_angles(
+                image,
+                &projection.texel_solid_angles(),
+            ));
         }
     };
+    Ok(add_rows(row_sums))
+}
+
+/// [`power`] from solid angles already computed (`omega`: the image's size, from
+/// [`Mapping::texel_solid_angles`]), for a caller that needs them for something else too; the
+/// same sums, in the same order, as [`power`] for every mapping but lat-long (which sums each
+/// row's radiance before weighting it). Cost O(W H).
+pub fn power_with_solid_angles(image: &Image<Rgb>, omega: &Image<f64>) -> [f64; 3] {
+    let w = image.width();
+    if (omega.width(), omega.height()) != (w, image.height()) {
+        return [f64::NAN; 3];
+    }
+    let row_sums: Vec<[f64; 3]> = (0..image.height())
+        .into_par_iter()
+        .map(|j| row_sum(image.row(j), Some(&omega.pixels()[j * w..(j + 1) * w])))
+        .collect();
+    add_rows(row_sums)
+}
+
+/// The row sums added top to bottom on one thread (deterministic whatever the thread count).
+fn add_rows(row_sums: Vec<[f64; 3]>) -> [f64; 3] {
     let mut total = [0.0; 3];
     for s in row_sums {
         for c in 0..3 {
             total[c] += s[c];
         }
     }
-    Ok(total)
+    total
 }
 
 /// Sum of a row of radiances, each weighted by its solid angle if given.

@@ -180,9 +180,16 @@ pub fn describe(env: &LoadedEnv, guessed: bool, frame: FramePreset, file: &str) 
         details: &env.details,
         report: env.report,
     };
+    // The solid angles serve the statistics and the power: computed once (they are most of
+    // the time on a large disc image).
+    let power = match env.mapping {
+        Mapping::LatLong => ibl_mapping::power(img, env.mapping),
+        _ => ibl_mapping::power_with_solid_angles(img, &solid),
+    };
     let bound = BoundMapping {
         mapping: env.mapping,
         guessed,
+        power,
     };
     info_of(img, &stats, &facts, Some(bound), frame, file)
 }
@@ -192,6 +199,8 @@ pub fn describe(env: &LoadedEnv, guessed: bool, frame: FramePreset, file: &str) 
 struct BoundMapping {
     mapping: Mapping,
     guessed: bool,
+    /// `sum L dOmega` per channel.
+    power: [f64; 3],
 }
 
 /// What the file said about itself, beside its pixels.
@@ -247,7 +256,7 @@ fn info_of(
         raw_min: loaded.report.raw_min.to_array(),
         negative_values: loaded.report.negative_values,
         nonfinite_values: loaded.report.nonfinite_values,
-        power: bound.map(|b| ibl_mapping::power(img, b.mapping)),
+        power: bound.map(|b| b.power),
         dynamic_range: DynamicRange {
             min_positive_luminance: if stats.min_pos_lum.is_finite() {
                 stats.min_pos_lum
