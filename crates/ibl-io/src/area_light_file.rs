@@ -210,7 +210,9 @@ impl AreaLightsFile {
             .iter()
             .filter_map(|l| l.area_patch().as_distant_light(at))
             .map(|mut l| {
-                l.direction = probe_from_world * l.direction;
+                // The file's rotation is orthonormal to 1e-3 only: renormalise (found by the
+                // `light_files` fuzz target, a direction 5e-4 off unit length).
+                l.direction = (probe_from_world * l.direction).normalize();
                 l
             })
             .collect();
@@ -289,6 +291,27 @@ mod tests {
                 ],
             }],
         )
+    }
+
+    #[test]
+    fn a_rotation_orthonormal_to_the_tolerance_still_gives_unit_directions() {
+        // Found by the `light_files` fuzz target: rows scaled by 1.0004 pass the 1e-3 check.
+        let mut file = sample();
+        for row in &mut file.world_from_probe {
+            for v in row.iter_mut() {
+                *v *= 1.0004;
+            }
+        }
+        assert!(file.check().is_ok());
+        let set = file.distant_lights();
+        assert!(!set.lights.is_empty());
+        for l in &set.lights {
+            assert!(
+                (l.direction.length() - 1.0).abs() < 1e-12,
+                "{}",
+                l.direction.length()
+            );
+        }
     }
 
     #[test]
