@@ -8,7 +8,8 @@
 #
 # Usage (from the repository root, after `bash fuzz/seed.sh`):
 #   RUSTC_BOOTSTRAP=1 bash fuzz/campaign.sh 3600 hdr exr      # one CPU-hour each
-# Two campaigns over disjoint targets use both cores of a 2-core machine.
+# Two campaigns over disjoint targets use both cores of a 2-core machine. NICE (default 10) is the
+# runs' nice level: 0 when the machine is left to the fuzzers.
 set -uo pipefail
 secs=$1
 shift
@@ -19,7 +20,7 @@ for t in "$@"; do
   out=$(mktemp)
   start=$(date -u +%Y-%m-%dT%H:%MZ)
   cpu=$(mktemp)
-  /usr/bin/time -f "%U %S" -o "$cpu" nice -n 10 cargo fuzz run -O "$t" -- \
+  /usr/bin/time -f "%U %S" -o "$cpu" nice -n "${NICE:-10}" cargo fuzz run -O "$t" -- \
     -max_total_time="$secs" -rss_limit_mb=4096 -timeout=30 -print_final_stats=1 >"$out" 2>&1
   rc=$?
   cpu_s=$(awk 'END {printf "%.0f", $1 + $2}' "$cpu")
