@@ -50,7 +50,7 @@ use std::path::{Path, PathBuf};
 use ibl_core::{Image, Rgb};
 
 pub use bounded_read::{check_regular, read_bounded, read_prefix, read_text};
-pub use error::{DecodeError, EncodeError, IoError};
+pub use error::{DecodeError, EncodeError, IoError, is_destination_fault};
 pub use exr::{ExrCompression, ExrOptions, ExrPrecision};
 pub use format::{
     DEFAULT_MAX_PIXELS, ImageFormat, Limits, MAX_MAX_PIXELS, MAX_PIXELS_VARIABLE, RawImage,

@@ -299,10 +299,6 @@ fn text(name: &str) -> Result<x::Text, DecodeError> {
         .ok_or_else(|| DecodeError::invalid(format!("channel name {name:?} is not Latin-1")))
 }
 
-/// Bounds what `exr` will allocate, judged on the headers exactly as `exr` parsed them (a hostile
-/// file with repeated attributes can make our own header parse and `exr`'s disagree, so the
-/// checks in [`check_file_size`] are repeated here on `exr`'s view): each uncompressed block at
-/// most [`MAX_BLOCK_BYTES`], and an offset table that fits in the file.
 /// The size (width, height) of the first part's data window, from the header alone (no pixel is
 /// decoded; `bytes` may be only the start of the file).
 pub fn header_size(bytes: &[u8]) -> Result<(usize, usize), DecodeError> {
@@ -316,6 +312,10 @@ pub fn header_size(bytes: &[u8]) -> Result<(usize, usize), DecodeError> {
     Ok((size(window.width())?, size(window.height())?))
 }
 
+/// Bounds what `exr` will allocate, judged on the headers exactly as `exr` parsed them (a hostile
+/// file with repeated attributes can make our own header parse and `exr`'s disagree, so the
+/// checks in [`check_file_size`] are repeated here on `exr`'s view): each uncompressed block at
+/// most [`MAX_BLOCK_BYTES`], and an offset table that fits in the file.
 fn check_parsed_headers(
     headers: &[::exr::meta::header::Header],
     len: usize,
