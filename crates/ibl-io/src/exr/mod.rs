@@ -337,6 +337,74 @@ fn check_parsed_headers(
     Ok(())
 }
 
+/// A DWAA/DWAB block starts with eleven little-endian u64 counters (OpenEXR's DWA chunk
+/// header): version, unknown uncompressed and compressed sizes, AC, DC and RLE compressed sizes,
+/// RLE uncompressed and raw sizes, AC and DC coefficient counts, AC compression. `exr` allocates
+/// by the sizes and counts before it reads the sections (a fuzzed file asked for 2^51 AC
+/// values, which aborts the process), so they are bounded here first: no section decodes to
+/// more than [`DWA_EXPANSION`] times the block's largest uncompressed size, plus 64 KiB for the
+/// 8 x 8 padding of tiny blocks. A real block is far within that.
+fn check_dwa_counters(
+    chunk: &Chunk,
+    headers: &[::exr::meta::header::Header],
+) -> Result<(), DecodeError> {
+    use ::exr::block::chunk::CompressedBlock;
+    use ::exr::compression::Compression;
+    let Some(header) = headers.get(chunk.layer_index) else {
+        return Ok(()); // `exr` reports the bad index itself.
+    };
+    if !matches!(
+        header.compression,
+        Compression::DWAA(_) | Compression::DWAB(_)
+    ) {
+        return Ok(());
+    }
+    let data = match &chunk.compressed_block {
+        CompressedBlock::ScanLine(b) => &b.compressed_pixels_le,
+        CompressedBlock::Tile(b) => &b.compressed_pixels_le,
+        _ => return Ok(()), // deep data is refused before any block is read
+    };
+    // The block's own uncompressed size, computed as `exr` does before decompressing; a block
+    // `exr` cannot place is left for it to refuse.
+    let Ok(section) = header
+        .get_block_data_indices(&chunk.compressed_block)
+        .and_then(|indices| header.get_absolute_block_pixel_coordinates(indices))
+    else {
+        return Ok(());
+    };
+    let expected =
+        (section.size.area() as u64).saturating_mul(header.channels.bytes_per_pixel as u64);
+    // Stored raw (as `exr` checks first) or empty: nothing is decoded by the counters.
+    if data.is_empty() || data.len() as u64 == expected {
+        return Ok(());
+    }
+    let bound = expected
+        .saturating_mul(DWA_EXPANSION)
+        .saturating_add(1 << 16);
+    let counter = |i: usize| {
+        data.get(8 * i..8 * i + 8)
+            .and_then(|b| b.try_into().ok())
+            .map(u64::from_le_bytes)
+    };
+    // Counters 1 (unknown uncompressed size), 6 and 7 (RLE sizes) are bytes; 8 and 9 (AC and DC
+    // counts) are u16 values.
+    for (i, bytes_each) in [(1, 1), (6, 1), (7, 1), (8, 2), (9, 2)] {
+        let Some(v) = counter(i) else {
+            return Ok(()); // a truncated header: `exr` refuses it
+        };
+        if v.saturating_mul(bytes_each) > bound {
+            return Err(DecodeError::Limits(format!(
+                "a DWA block's header asks for {v} values in section {i}, more than its {expected}-byte \
+                 block can hold"
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// How many times a DWA block's largest uncompressed size any of its sections may decode to.
+const DWA_EXPANSION: u64 = 8;
+
 /// Compressed chunks decompressed together: bounds the extra memory to that many blocks.
 const CHUNK_BATCH: usize = 64;
 
@@ -367,6 +435,9 @@ fn decode_layers<'s, L: ReadLayers<'s>>(
             .map_err(from_exr_error)?;
         if batch.is_empty() {
             break;
+        }
+        for chunk in &batch {
+            check_dwa_counters(chunk, &meta.headers)?;
         }
         let blocks: Vec<_> = batch
             .into_par_iter()
