@@ -5,7 +5,9 @@
 //!
 //! The folder is probed by creating and removing an empty file in it: permission bits do not
 //! tell (root writes through them, a read-only mount or `/proc` refuses root too), an attempt
-//! does. The probe file's name starts with `.iblkit-check-` and the process id.
+//! does. The probe file is a temporary file like any other (`ibl_io::temp_files`):
+//! `.iblkit-tmp-<pid>-check`, listed while it exists, so an interrupt during the check removes
+//! it too.
 
 use std::fs::OpenOptions;
 use std::path::Path;
@@ -64,7 +66,8 @@ pub fn check_output_pixels(what: &str, width: usize, height: usize) -> Result<()
 
 /// Checks that `folder` (an existing folder) takes a new file, by creating and removing one.
 pub fn check_folder_takes_files(folder: &Path) -> std::io::Result<()> {
-    let probe = folder.join(format!(".iblkit-check-{}", std::process::id()));
+    let probe = folder.join(format!("{}check", ibl_io::temp_files::temp_prefix()));
+    let _listed = ibl_io::temp_files::TempRegistration::new(&probe);
     OpenOptions::new()
         .write(true)
         .create_new(true)
