@@ -24,10 +24,7 @@ use crate::IoError;
 /// naming its size and the bound. Nothing over `max_bytes + 1` bytes is ever read or allocated.
 pub fn read_bounded(path: &Path, max_bytes: u64) -> Result<Vec<u8>, IoError> {
     let io = |e| IoError::read(path, e);
-    check_regular(path, &std::fs::metadata(path).map_err(io)?)?;
-    let file = File::open(path).map_err(io)?;
-    let meta = file.metadata().map_err(io)?;
-    check_regular(path, &meta)?;
+    let (file, meta) = open_regular(path)?;
     if meta.len() > max_bytes {
         return Err(over_limit(path, meta.len(), max_bytes));
     }
@@ -49,13 +46,23 @@ pub fn read_bounded(path: &Path, max_bytes: u64) -> Result<Vec<u8>, IoError> {
 /// Reads the first `max_bytes` of `path` (all of it when shorter), a regular file only (the same
 /// type checks as [`read_bounded`]); for headers.
 pub fn read_prefix(path: &Path, max_bytes: u64) -> Result<Vec<u8>, IoError> {
+    let (file, _) = open_regular(path)?;
+    let mut bytes = Vec::new();
+    file.take(max_bytes)
+        .read_to_end(&mut bytes)
+        .map_err(|e| IoError::read(path, e))?;
+    Ok(bytes)
+}
+
+/// Opens `path` for reading if it is a regular file, checked twice: by its path before opening
+/// (a FIFO would block `open`) and by the opened handle (the path may have been replaced between).
+fn open_regular(path: &Path) -> Result<(File, Metadata), IoError> {
     let io = |e| IoError::read(path, e);
     check_regular(path, &std::fs::metadata(path).map_err(io)?)?;
     let file = File::open(path).map_err(io)?;
-    check_regular(path, &file.metadata().map_err(io)?)?;
-    let mut bytes = Vec::new();
-    file.take(max_bytes).read_to_end(&mut bytes).map_err(io)?;
-    Ok(bytes)
+    let meta = file.metadata().map_err(io)?;
+    check_regular(path, &meta)?;
+    Ok((file, meta))
 }
 
 /// Reads a UTF-8 text file of at most `max_bytes` (through [`read_bounded`]); text that is not

@@ -58,6 +58,24 @@ fn unit_from_name(path: &Path) -> Option<TimeUnit> {
     }
 }
 
+/// The exposure time in seconds that `token` of `path` gives in `unit`, positive and finite (the
+/// inverse of a subnormal, `1e-310` in a `list.txt`, is infinite and refused like any other bad
+/// value); `shown` is how the error message names the token.
+fn seconds_of(path: &Path, token: &str, shown: &str, unit: TimeUnit) -> Result<f64> {
+    parse_value(token)
+        .map(|v| match unit {
+            TimeUnit::Seconds => v,
+            TimeUnit::InverseSeconds => 1.0 / v,
+        })
+        .filter(|s| s.is_finite() && *s > 0.0)
+        .ok_or_else(|| {
+            PipelineError::parameter(format!(
+                "{}: {shown} is not a positive exposure time",
+                path.display()
+            ))
+        })
+}
+
 /// Reads the exposure times of `images` (in their order, seconds) from the text of `path`.
 /// `unit` is the caller's `--times-unit`, if given. Returns the times and the unit used.
 pub fn parse_times_file(
@@ -80,28 +98,13 @@ pub fn parse_times_file(
     let named = lines
         .first()
         .is_some_and(|t| parse_value(t[0]).is_none() && t.len() == 2);
-    // A time in seconds, positive and finite: the inverse of a subnormal (`1e-310` in a
-    // `list.txt`) is infinite and refused like any other bad value.
-    let to_seconds = |v: f64, unit: TimeUnit| {
-        let s = match unit {
-            TimeUnit::Seconds => v,
-            TimeUnit::InverseSeconds => 1.0 / v,
-        };
-        (s.is_finite() && s > 0.0).then_some(s)
-    };
     if !named {
         let unit = unit.unwrap_or(TimeUnit::Seconds);
-        let mut times = Vec::new();
-        for token in lines.iter().flatten() {
-            let t = parse_value(token)
-                .and_then(|v| to_seconds(v, unit))
-                .ok_or_else(|| {
-                    PipelineError::parameter(format!(
-                        "{shown}: '{token}' is not a positive exposure time"
-                    ))
-                })?;
-            times.push(t);
-        }
+        let times = lines
+            .iter()
+            .flatten()
+            .map(|token| seconds_of(path, token, &format!("'{token}'"), unit))
+            .collect::<Result<Vec<_>>>()?;
         return Ok((times, unit));
     }
     let unit = unit.or_else(|| unit_from_name(path)).ok_or_else(|| {
@@ -119,13 +122,7 @@ pub fn parse_times_file(
                 tokens.len()
             )));
         };
-        let t = parse_value(value)
-            .and_then(|v| to_seconds(v, unit))
-            .ok_or_else(|| {
-                PipelineError::parameter(format!(
-                    "{shown}: '{value}' ({name}) is not a positive exposure time"
-                ))
-            })?;
+        let t = seconds_of(path, value, &format!("'{value}' ({name})"), unit)?;
         entries.push((name.to_string(), t));
     }
     let mut times = Vec::with_capacity(images.len());
