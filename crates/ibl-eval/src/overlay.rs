@@ -190,6 +190,7 @@ mod tests {
             solid_angle_sr: 1.0,
             irradiance: Rgb64::new(irradiance, irradiance, irradiance),
             region,
+            spread_sr: None,
         }
     }
 

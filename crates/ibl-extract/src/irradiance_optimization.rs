@@ -394,6 +394,7 @@ fn black_fit(n: usize, normals: usize) -> Fit {
             solid_angle_sr: SOURCE_SOLID_ANGLE_SR,
             irradiance: Rgb64::ZERO,
             region: None,
+            spread_sr: None,
         })
         .collect();
     let report = FitReport {
@@ -704,6 +705,7 @@ impl Problem {
                     radiance: Rgb::new(radiance[0], radiance[1], radiance[2]),
                     solid_angle_sr: SOURCE_SOLID_ANGLE_SR,
                     irradiance: Rgb64::from_array(irradiance),
+                    spread_sr: None,
                     region: None,
                 }
             })

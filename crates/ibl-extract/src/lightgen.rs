@@ -54,7 +54,7 @@
 
 use glam::DVec3;
 use ibl_core::{Image, Rgb};
-use ibl_light::{Extraction, LightSet, Provenance};
+use ibl_light::{Extraction, Light, LightSet, Provenance, SpreadHistogram};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 use rayon::prelude::*;
@@ -113,6 +113,8 @@ struct Point {
     power: [f64; 3],
     /// Solid angle, sr.
     solid_angle: f64,
+    /// `sum E_p dOmega_p`, sr^2 x luminance: its pixels' own extent in a light's spread.
+    extent: f64,
 }
 
 impl Point {
@@ -124,6 +126,7 @@ impl Point {
             dir: DVec3::Y,
             power: [0.0; 3],
             solid_angle: 0.0,
+            extent: 0.0,
         }
     }
 
@@ -135,6 +138,7 @@ impl Point {
             *p += lc * sr;
         }
         self.solid_angle += sr;
+        self.extent += energy * sr;
     }
 
     fn finish(mut self) -> Point {
@@ -200,8 +204,9 @@ pub fn lightgen(
             *sc += pc;
         }
         s.solid_angle += p.solid_angle;
+        s.extent += p.extent;
     }
-    let mut lights: Vec<_> = sums
+    let mut lights: Vec<(f64, Light)> = sums
         .iter()
         .zip(&best.centres)
         .map(|(s, c)| {
@@ -210,9 +215,21 @@ pub fn lightgen(
                 .try_normalize()
                 .or_else(|| s.geometric.try_normalize())
                 .unwrap_or(*c);
-            (s.energy, light(dir, s.power, s.solid_angle, None))
+            (s.energy, light(dir, s.power, s.solid_angle, None, None))
         })
         .collect();
+    // Each light's spread about its direction from its points ([`ibl_light::spread`]; a
+    // block's own extent taken as its pixels' mean solid angle).
+    let mut spreads = vec![SpreadHistogram::new(); n];
+    for (p, &k) in points.iter().zip(&best.assignment) {
+        if p.energy > 0.0 {
+            let key = 1.0 - p.dir.dot(lights[k].1.direction);
+            spreads[k].add(key, p.energy, p.extent / p.energy);
+        }
+    }
+    for ((_, l), h) in lights.iter_mut().zip(&spreads) {
+        l.spread_sr = h.spread_sr();
+    }
     lights.sort_by(|a, b| b.0.total_cmp(&a.0));
     Ok(LightSet {
         provenance: Provenance::extracted(Extraction::LightGen {

@@ -197,6 +197,7 @@ fn sun_set(
             solid_angle_sr: sun.solid_angle_sr,
             irradiance: sun.irradiance,
             region: None,
+            spread_sr: None,
         }],
     })
 }

@@ -36,8 +36,11 @@
 //! about 1e-15 relative): power per channel `I = sum L_p dOmega_p`, solid angle `A = sum
 //! dOmega_p`, radiance `I / A`, direction `S / |S|` (the solid-angle weighted mean direction where
 //! the region is black), with S summed per pixel too (median cut) or taken from the direction
-//! table (adaptive median cut, variance minimisation). Cost O(W H) over a partition, in parallel
-//! over regions.
+//! table (adaptive median cut, variance minimisation), and the spread: the solid angle of the
+//! uniform cone with the region's half-energy angle about that direction
+//! ([`ibl_light::spread`], a second pass over the pixels), which sizes the light's soft shadow
+//! (a sun in a region of sky casts the sun's sharp one). Cost O(W H) over a
+//! partition, in parallel over regions.
 
 use std::collections::BinaryHeap;
 
@@ -47,7 +50,7 @@ use rayon::prelude::*;
 
 use crate::ExtractError;
 use ibl_core::rgb::Rgb64;
-use ibl_light::{Light, PixelRegion};
+use ibl_light::{Light, PixelRegion, SpreadHistogram};
 
 /// Rec. 709 luminance weights in f64 (the same numbers as `ibl_core::rgb::LUMINANCE_WEIGHTS`).
 const LUMINANCE: [f64; 3] = [
@@ -574,14 +577,70 @@ fn region_light<const SUM_MOMENT: bool>(
         .try_normalize()
         .or_else(|| geometric.try_normalize())
         .unwrap_or(DVec3::Y);
-    light(dir, power, solid_angle, Some(r))
+    let spread = region_spread(probe, grid, &r, dir);
+    light(dir, power, solid_angle, spread, Some(r))
 }
 
-/// A light from its direction (unit), power per channel (probe unit x sr) and solid angle (sr).
+/// Rows per chunk of [`region_spread`]'s parallel histograms.
+const SPREAD_ROWS: usize = 16;
+
+/// The spread of region `r`'s power about `dir` (unit), sr ([`ibl_light::spread`]): a second
+/// pass over its pixels into a [`SpreadHistogram`]. A large region's rows are histogrammed in
+/// chunks of [`SPREAD_ROWS`] in parallel and merged in row order, so the result does not depend
+/// on the thread count. Cost O(area).
+fn region_spread(probe: &Image<Rgb>, grid: &Grid, r: &PixelRegion, dir: DVec3) -> Option<f64> {
+    // Per row: the keys and luminances first (a loop the compiler can vectorise), then the
+    // histogram's runs.
+    let add_row = |h: &mut SpreadHistogram, keys: &mut Vec<(f64, f64)>, j: usize| {
+        let o = grid.row_sr[j];
+        let (st, ct) = grid.row_trig[j];
+        // d_p . w with d_p = (st sp, ct, -st cp).
+        let (a, b, c) = (st * dir.x, ct * dir.y, st * dir.z);
+        let trig = &grid.col_trig[r.x0..r.x1];
+        let row = &probe.row(j)[r.x0..r.x1];
+        keys.clear();
+        each_pixel(row, grid.clean[j], trig, |&(sp, cp), _, y| {
+            keys.push((1.0 - (a * sp + b - c * cp), y));
+        });
+        h.add_pixels(keys, o);
+    };
+    let chunk = |y0: usize| {
+        let mut h = SpreadHistogram::new();
+        let mut keys = Vec::with_capacity(r.width());
+        for j in y0..(y0 + SPREAD_ROWS).min(r.y1) {
+            add_row(&mut h, &mut keys, j);
+        }
+        h
+    };
+    let starts = (r.y0..r.y1).step_by(SPREAD_ROWS);
+    let histogram = if r.width() * r.height() > PARALLEL_AREA {
+        let parts: Vec<SpreadHistogram> = starts
+            .collect::<Vec<_>>()
+            .into_par_iter()
+            .map(chunk)
+            .collect();
+        parts.iter().fold(SpreadHistogram::new(), |mut all, h| {
+            all.merge(h);
+            all
+        })
+    } else {
+        let mut h = SpreadHistogram::new();
+        let mut keys = Vec::with_capacity(r.width());
+        for j in r.y0..r.y1 {
+            add_row(&mut h, &mut keys, j);
+        }
+        h
+    };
+    histogram.spread_sr()
+}
+
+/// A light from its direction (unit), power per channel (probe unit x sr), solid angle (sr) and
+/// spread (sr, [`Light::spread_sr`]).
 pub(crate) fn light(
     dir: DVec3,
     power: [f64; 3],
     solid_angle: f64,
+    spread: Option<f64>,
     region: Option<PixelRegion>,
 ) -> Light {
     let radiance = if solid_angle > 0.0 {
@@ -599,5 +658,6 @@ pub(crate) fn light(
         solid_angle_sr: solid_angle,
         irradiance: Rgb64::from_array(power),
         region,
+        spread_sr: spread,
     }
 }

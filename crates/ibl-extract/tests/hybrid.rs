@@ -47,6 +47,7 @@ fn sun_light(probe: &Image<Rgb>) -> LightSet {
             solid_angle_sr: sun.solid_angle_sr,
             irradiance: sun.irradiance,
             region: None,
+            spread_sr: None,
         }],
     }
 }

@@ -527,6 +527,7 @@ mod tests {
             solid_angle_sr: 0.01,
             irradiance: Rgb64::from_array(irradiance),
             region: None,
+            spread_sr: None,
         }
     }
 

@@ -1,7 +1,8 @@
 //! The JSON light-set file, CONVENTIONS section 7: `"format": "iblkit.lights/1"`, the source probe
 //! (path, size, sha256), the frame the directions are written in, the method with its parameters,
 //! and per light `direction`, `radiance`, `solid_angle` (sr), `irradiance` (`I = L A`) and optional
-//! region bounds in probe pixels; a hybrid set adds its SH ambient.
+//! region bounds in probe pixels and `spread` (sr, the solid angle soft shadows are sized by); a
+//! hybrid set adds its SH ambient.
 //!
 //! The lights are `ibl_light` types as they are (their serde form is the per-light record); the
 //! method is [`ibl_light::Extraction`], written as its name and its parameters as named numbers
@@ -237,13 +238,15 @@ pub fn light_set_from_json(path: &Path, bytes: &[u8]) -> Result<LightSet, IoErro
             && (d.length() - 1.0).abs() < 1e-3
             && irradiance.iter().all(|c| c.is_finite() && *c >= 0.0)
             && l.solid_angle_sr.is_finite()
-            && l.solid_angle_sr >= 0.0;
+            && l.solid_angle_sr >= 0.0
+            && l.spread_sr
+                .is_none_or(|a| a.is_finite() && (0.0..=4.0 * std::f64::consts::PI).contains(&a));
         if !ok {
             return Err(IoError::Invalid {
                 path: path.to_path_buf(),
                 reason: format!(
-                    "light {i}: direction must be a unit vector and irradiance and solid angle \
-                     finite and non-negative"
+                    "light {i}: direction must be a unit vector, irradiance and solid angle \
+                     finite and non-negative, and spread (if given) from 0 to 4 pi sr"
                 ),
             });
         }
@@ -292,6 +295,7 @@ mod tests {
                         x1: 2,
                         y1: 3,
                     }),
+                    spread_sr: Some(0.25),
                 }],
             },
             frame,
@@ -315,6 +319,7 @@ mod tests {
         assert!(keys.windows(2).all(|w| w[0] < w[1]), "{text}");
         assert!(text.contains("\"converged\": 1,") && text.contains("\"iterations\": 3,"));
         assert!(text.contains("\"solid_angle\": 0.5") && text.contains("\"x1\": 2"));
+        assert!(text.contains("\"spread\": 0.25"), "{text}");
         assert!(!text.contains("ambient"));
     }
 

@@ -62,6 +62,26 @@ pub struct Light {
     /// The probe pixels this light stands for (region methods only).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub region: Option<PixelRegion>,
+    /// How widely the light's power spreads about `direction`: the solid angle (sr) of the
+    /// uniform cone with the same half-energy angle ([`crate::spread`]). A sun inside a region of
+    /// dim sky spreads far less than the region's `solid_angle`; soft shadows are sized by it
+    /// ([`Light::shadow_solid_angle_sr`]). Measured by the methods that have the light's pixels;
+    /// `None` where not measured.
+    #[serde(default, rename = "spread", skip_serializing_if = "Option::is_none")]
+    pub spread_sr: Option<f64>,
+}
+
+impl Light {
+    /// The solid angle (sr) of the uniform cone that stands for this light in soft shadows and
+    /// in the hybrid's ambient: its measured spread where known, but never more than its
+    /// source's solid angle (a long thin region spreads one way only, and an isotropic cone of
+    /// its spread blurs shadows the other way too: on the bundled apartment scene median cut's
+    /// relative MSE rose from 3.0e-3 to 4.8e-3 at 16 lights without the bound), else the source's
+    /// solid angle.
+    pub fn shadow_solid_angle_sr(&self) -> f64 {
+        self.spread_sr
+            .map_or(self.solid_angle_sr, |s| s.min(self.solid_angle_sr))
+    }
 }
 
 /// A set of directional lights approximating a probe, with what made it.
@@ -148,6 +168,7 @@ mod tests {
                     solid_angle_sr: 0.5,
                     irradiance: Rgb64::new(0.5, 1.0, 1.5),
                     region: None,
+                    spread_sr: None,
                 },
                 Light {
                     direction: DVec3::NEG_Z,
@@ -160,9 +181,19 @@ mod tests {
                         x1: 4,
                         y1: 8,
                     }),
+                    spread_sr: Some(0.125),
                 },
             ],
         }
+    }
+
+    #[test]
+    fn shadows_take_the_spread_within_the_solid_angle() {
+        let mut s = set();
+        assert_eq!(s.lights[0].shadow_solid_angle_sr(), 0.5);
+        assert_eq!(s.lights[1].shadow_solid_angle_sr(), 0.125);
+        s.lights[1].spread_sr = Some(2.0);
+        assert_eq!(s.lights[1].shadow_solid_angle_sr(), 0.25);
     }
 
     #[test]

@@ -28,6 +28,7 @@ pub mod goniometric;
 pub mod method;
 pub mod patch;
 pub mod provenance;
+pub mod spread;
 
 pub use daylight::{Sky, Sun};
 pub use directional::{Light, LightSet, PixelRegion};
@@ -36,3 +37,4 @@ pub use goniometric::{CandelaTable, GoniometricLight, PhotometryError, intensity
 pub use method::{LightSource, MAX_MEDIAN_CUT_SPLITS, Method, MethodError};
 pub use patch::AreaPatch;
 pub use provenance::{Extraction, FitReport, ParameterError, ProbeRef, Provenance};
+pub use spread::SpreadHistogram;

@@ -61,6 +61,7 @@ impl AreaPatch {
             solid_angle_sr,
             irradiance,
             region: None,
+            spread_sr: None,
         })
     }
 }

@@ -30,6 +30,12 @@ def test_every_method_makes_lights_that_keep_the_power(sky, method):
         # power (sum L dOmega) up to f64 summation order.
         power = np.asarray(iblkit.info(sky)["power"])
         np.testing.assert_allclose(lights.total_power, power, rtol=1e-9)
+        # Their shadows are sized by each light's measured spread, never wider than its region.
+        shadow = lights.shadow_solid_angles
+        assert np.all(shadow >= 0.0) and np.all(shadow <= lights.solid_angles)
+        # The sky's sun: its light spreads over far less than its region.
+        sun = int(np.argmax(lights.irradiance.sum(axis=1)))
+        assert shadow[sun] < 0.5 * lights.solid_angles[sun]
 
 
 def test_lights_equal_the_cli_file(tmp_path, sky, ibl):

@@ -56,6 +56,20 @@ impl PyLightSet {
         Array1::from(v).into_pyarray(py)
     }
 
+    /// Solid angle of the uniform cone that sizes each light's soft shadow, sr, (N,): its
+    /// measured spread (the cone with the light's half-energy angle) within its region's solid
+    /// angle, or the solid angle where the method measures no spread.
+    #[getter]
+    fn shadow_solid_angles<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        let v: Vec<f64> = self
+            .set
+            .lights
+            .iter()
+            .map(|l| l.shadow_solid_angle_sr())
+            .collect();
+        Array1::from(v).into_pyarray(py)
+    }
+
     /// The extraction method's name.
     #[getter]
     fn method(&self) -> String {

@@ -230,7 +230,7 @@ fn with_cones_spread(ambient: &RadianceSh, lights: &LightSet) -> RadianceSh {
     let bands = ambient.bands();
     let mut coefficients = ambient.coefficients().to_vec();
     for light in &lights.lights {
-        let a = light.solid_angle_sr;
+        let a = light.shadow_solid_angle_sr();
         if !(a.is_finite() && a > 0.0) {
             continue;
         }
@@ -284,7 +284,9 @@ fn light_list(scene: &Scene, set: &LightSet, shadows: ShadowKind) -> LightList {
 
 impl LightList {
     /// The renderer's lights of `set` (its frame turned to the world by `world_from_set`): black
-    /// lights dropped, each with the cone of its solid angle `A_i` (soft shadows).
+    /// lights dropped, each with the cone of its shadow solid angle (soft shadows): its spread
+    /// where the extraction measured it, else its solid angle `A_i`
+    /// ([`ibl_light::Light::shadow_solid_angle_sr`]).
     pub fn from_set(set: &LightSet, world_from_set: DMat3, shadows: ShadowKind) -> LightList {
         let lights: Vec<DirectionalLight> = set
             .lights
@@ -301,7 +303,7 @@ impl LightList {
                         l.irradiance.g as f32,
                         l.irradiance.b as f32,
                     ),
-                    cone: UniformCone::from_solid_angle(l.solid_angle_sr as f32),
+                    cone: UniformCone::from_solid_angle(l.shadow_solid_angle_sr() as f32),
                     frame: OrthonormalBasis::from_normal(direction),
                 }
             })

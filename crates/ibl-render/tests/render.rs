@@ -123,6 +123,7 @@ fn one_light(direction: DVec3, irradiance: [f64; 3], solid_angle_sr: f64) -> Lig
             solid_angle_sr,
             irradiance: Rgb64::from_array(irradiance),
             region: None,
+            spread_sr: None,
         }],
     }
 }

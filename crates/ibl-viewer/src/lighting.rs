@@ -291,6 +291,7 @@ mod tests {
                     x1: 6,
                     y1: 4,
                 }),
+                spread_sr: None,
             }],
         };
         let mask = region_borders(&set, 8, 6).expect("a region");
