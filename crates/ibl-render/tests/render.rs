@@ -958,3 +958,20 @@ fn centre_ray_incidence(scene: &Scene, x: usize, y: usize, w: usize, h: usize) -
     }
     (-d.dot(o + d * (-b - disc.sqrt()))).clamp(0.0, 1.0)
 }
+
+#[test]
+fn soft_shadow_cones_take_each_lights_spread_within_its_solid_angle() {
+    // The cone of a light is its measured spread, at most its solid angle; a light without a
+    // spread keeps its solid angle (ibl_light::Light::shadow_solid_angle_sr).
+    let mut set = one_light(DVec3::Y, [1.0; 3], 0.5);
+    let cone_sr = |set: &LightSet| {
+        let list =
+            ibl_render::lighting::LightList::from_set(set, glam::DMat3::IDENTITY, ShadowKind::Soft);
+        list.lights[0].cone.expect("a soft cone").solid_angle()
+    };
+    assert!((cone_sr(&set) - 0.5).abs() < 1e-6);
+    set.lights[0].spread_sr = Some(0.01);
+    assert!((cone_sr(&set) - 0.01).abs() < 1e-7);
+    set.lights[0].spread_sr = Some(3.0);
+    assert!((cone_sr(&set) - 0.5).abs() < 1e-6);
+}
