@@ -20,7 +20,9 @@
 //!   With the default `s = 1` the probe's values are read as luminance in cd/m^2 (nits), for which
 //!   `Y(I)` (cd/m^2 x sr = lm/m^2) already is lux; for a probe in relative units, choose `s` to
 //!   make the brightest light match a measured illuminance. A black light gets `color = [1, 1, 1]`
-//!   and `intensity = 0`. `I` and `A` are also kept in each light's `extras`.
+//!   and `intensity = 0`. `I` and `A` are also kept in each light's `extras`, with the solid
+//!   angle of the cone its soft shadow is sized by (`shadow_solid_angle`, the light's spread
+//!   within `A`).
 //! - **Mitsuba 3**: `<emitter type="directional">` with `direction = p` (Mitsuba's `direction` is
 //!   the way the light radiates) and `irradiance = I` as `<rgb>`.
 //! - **pbrt-v4**: `LightSource "distant"` with `from = direction`, `to = 0` (pbrt's light travels
@@ -294,6 +296,7 @@ fn gltf_value(lights: &[Light], options: &ExportOptions) -> Result<serde_json::V
                 "irradiance": c.irradiance,
                 "illuminance_lux": s * luminance(c.irradiance),
                 "solid_angle": record.solid_angle_sr,
+                "shadow_solid_angle": record.shadow_solid_angle_sr(),
             },
         }));
         nodes.push(json!({
@@ -609,6 +612,7 @@ mod tests {
             let y = luminance(color.map(|c| c * intensity));
             assert!((y - lux * luminance(l.irradiance.to_array())).abs() < 1e-9);
             assert!((f(&light["extras"]["illuminance_lux"]) - y).abs() < 1e-9);
+            assert_eq!(f(&light["extras"]["shadow_solid_angle"]), 0.01);
         }
     }
 
