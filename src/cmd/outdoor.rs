@@ -26,7 +26,7 @@ Examples:
   ibl outdoor scene.toml --out run --video run/composites.mp4 --video-fps 2
   ibl outdoor scene.toml --out run --no-composites --json > run.json")]
 pub struct OutdoorArgs {
-    /// Scene file with an [outdoor] table (docs/SCENES.md).
+    /// Scene file with an `[outdoor]` table (docs/SCENES.md).
     scene: PathBuf,
     /// Output folder (created when missing).
     #[arg(long, value_name = "DIR")]

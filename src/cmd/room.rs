@@ -122,7 +122,7 @@ Examples:
   ibl room estimate assets/rooms/apartment/room.toml -o apartment-room
   ibl room estimate assets/rooms/synthetic/room.toml -o synthetic --important 16 --json")]
 struct EstimateArgs {
-    /// Room file (.toml with [probe] and [room]).
+    /// Room file (.toml with `[probe]` and `[room]`).
     room: PathBuf,
     /// Output folder (created if missing).
     #[arg(short = 'o', long, value_name = "DIR")]
@@ -148,7 +148,7 @@ Examples:
   ibl room lights assets/rooms/apartment/room.toml -n 32 -o apartment-lights.json
   ibl render assets/scenes/bunny-sky.toml -o b.exr --mode lights --lights apartment-lights.json")]
 struct LightsArgs {
-    /// Room file (.toml with [probe] and [room]).
+    /// Room file (.toml with `[probe]` and `[room]`).
     room: PathBuf,
     /// Area-light file to write (.json).
     #[arg(short = 'o', long, value_name = "FILE.json")]

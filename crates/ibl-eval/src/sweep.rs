@@ -5,7 +5,7 @@
 //! (CONVENTIONS section 5, [`GroundTruth::fibonacci`], timed). Then for each method and N the
 //! method runs through [`ibl_extract::extract`] (timed, wall clock), its light set gives
 //! `e_k = sum_i I_i max(0, n_k . w_i)` on the same normals (data-parallel with rayon) and
-//! [`GroundTruth::error_of`] turns the pair into the four metrics of [`ibl_core::metrics`]
+//! [`GroundTruth::error_of`] turns the pair into the four metrics of [`ibl_metrics`]
 //! (`mean_err%`, `max_err%`, `rel_mean%`, `rel_max%`, per cent of the channel's mean irradiance
 //! or of the normal's own irradiance).
 //!

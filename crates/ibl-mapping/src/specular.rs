@@ -15,7 +15,7 @@
 //! `lod = 1/2 log2(Omega_s / Omega_p)` with `Omega_s = 1 / (N p(l))` and `Omega_p` the
 //! source texel's solid angle (Krivanek & Colbert eq. 13): a few hundred
 //! samples then integrate the lobe without the noise of point samples. (Krivanek & Colbert add
-//! a bias of 1; we use 0, see [`LOD_BIAS`].)
+//! a bias of 1; we use 0, see `LOD_BIAS`.)
 //!
 //! **Energy.** The weights are normalised, so a constant environment prefilters to itself at
 //! every roughness (exactly, to f32 rounding) and the kernel, a function of `n.l` alone, keeps

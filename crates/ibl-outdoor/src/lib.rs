@@ -16,7 +16,7 @@
 //! - [`maps`]: the offline maps in the probe's lat-long (normal, weighted ambient, shadow,
 //!   albedo by inverse rendering) and the capture lighting.
 //! - [`samples`]: the camera pixels the estimation reads, with their model inputs.
-//! - [`estimate`]: the robust per-frame fit of `P_d` and `P_a` with its confidence.
+//! - [`mod@estimate`]: the robust per-frame fit of `P_d` and `P_a` with its confidence.
 //! - [`smoothing`]: optional temporal smoothing (a Kalman filter per parameter).
 //! - [`relight`]: the relit environment map and the sun as a directional light.
 //! - [`volume_refresh`]: the irradiance volume from the relit map (a) or from key-point

@@ -2,7 +2,7 @@
 //! glTF-IBL-Sampler make): the GGX-prefiltered specular mip chain as a KTX2 or DDS cube map (and
 //! optionally a lat-long chain), the irradiance cube `E / pi`, spherical harmonics in any tool's
 //! convention, and the split-sum DFG table. Every output path is checked before any work; the
-//! maps are made in memory by [`ibl_mapping::prefilter`], the SH by [`ibl_sh::project_latlong`],
+//! maps are made in memory by [`ibl_mapping::prefilter()`], the SH by [`ibl_sh::project_latlong`],
 //! and each file is written atomically through `ibl-io`. `docs/PREFILTER.md` has the
 //! conventions and the roughness each engine expects at each level.
 

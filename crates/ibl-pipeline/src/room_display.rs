@@ -8,7 +8,7 @@
 //!   material changes), so a shadow on the room subtracts exactly Grosch's
 //!   `dL_i = rho / pi E_i` of the light the objects block.
 //! - **Background**: the edited panorama the probe shows (material changes with their colour
-//!   bleeding, new lights with their bounces: [`EditedRoom::panorama`]), without the objects.
+//!   bleeding, new lights with their bounces: [`crate::room_render::EditedRoom::panorama`]), without the objects.
 //! - **Lights**: each important patch as a point at its centroid (1 cm in front of it) radiating
 //!   `L A cos theta` into its front hemisphere (a Lambertian patch seen from afar: its
 //!   intensity times `cos theta_e / d^2` is the patch's irradiance, EQ5 with

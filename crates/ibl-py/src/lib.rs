@@ -3,17 +3,17 @@
 //! command of the same name give the same numbers.
 //!
 //! - Images are numpy `float32` arrays of shape `(H, W, 3)`, linear radiance, row 0 at the top
-//!   ([`arrays`]). Any array-like is accepted and converted (a copy); results are new arrays.
+//!   (`arrays`). Any array-like is accepted and converted (a copy); results are new arrays.
 //! - Directions are in iblkit's world frame (docs/CONVENTIONS.md: +Y up, -Z forward, +X right).
-//! - Errors are [`errors::BadInputError`] (a `ValueError`: the caller's file or argument) or
-//!   [`errors::InternalError`] (a `RuntimeError`: ours), with the same messages as `ibl`.
+//! - Errors are `errors::BadInputError` (a `ValueError`: the caller's file or argument) or
+//!   `errors::InternalError` (a `RuntimeError`: ours), with the same messages as `ibl`.
 //! - Long calls release the GIL (`Python::detach`) and report progress through an optional
-//!   Python callable `progress(label, done, total)` ([`progress`]).
+//!   Python callable `progress(label, done, total)` (`progress`).
 //!
-//! Modules: [`images`] (read, write, convert, probes, info), [`lights`] (extraction, light sets
-//! and their files), [`sh`] (projection and every tool's convention), [`evaluation`] (ground
-//! truth and error metrics), [`maps`] (irradiance and prefiltered maps), [`scene`] (renders),
-//! [`batch`] (the batch job's three steps, for `iblkit.batch`).
+//! Modules: `images` (read, write, convert, probes, info), `lights` (extraction, light sets
+//! and their files), `sh` (projection and every tool's convention), `evaluation` (ground
+//! truth and error metrics), `maps` (irradiance and prefiltered maps), `scene` (renders),
+//! `batch` (the batch job's three steps, for `iblkit.batch`).
 
 mod arrays;
 mod batch;

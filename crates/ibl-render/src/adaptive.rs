@@ -106,7 +106,7 @@ fn deviates(value: Rgb, mean: Rgb, contrast: f32) -> bool {
 }
 
 /// The first pass's coarse grid: pixels with even `x` and `y` trace every light; the others
-/// take, for each light, the answer that all coarse pixels within [`REACH`] pixels in `x` and
+/// take, for each light, the answer that all coarse pixels within `REACH` pixels in `x` and
 /// in `y` (3 x 3 to 4 x 4 of them) that met the same kind of surface found
 /// ([`KnownVisibility`]), and trace the rest. Nine or more agreeing samples keep a soft
 /// shadow's random first samples from agreeing by chance (with two, a cone half hidden agrees

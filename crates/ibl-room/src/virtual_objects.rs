@@ -15,7 +15,7 @@
 //! In both, the objects' **shadows on the real surfaces** subtract what they take from the
 //! important patches (the paper's `dL_i = rho E_i / pi`, `L'_pixel = L_pixel - dL_i`): at a real
 //! point `x` of patch `p`, `rho_p / pi` times the part of each `E_i(x)` that reaches `x` through
-//! the room but not past the objects (the difference of the two shadow images of [GM00]).
+//! the room but not past the objects (the difference of the two shadow images of \[GM00\]).
 //! Grosch stores `dL_i` at patch vertices; here it is evaluated at each displayed point, so the
 //! shadow is as sharp as the picture.
 //!

@@ -166,7 +166,7 @@ pub struct ViewArgs {
     pub edit: Option<PathBuf>,
     /// Draw the --edit file's objects live on the GPU, in the room as the real layer, with
     /// Grosch's display the file names (fast or improved): they can be dragged, every patch's
-    /// shadow following. The frame is the scene camera's: the file's [view], or from the
+    /// shadow following. The frame is the scene camera's: the file's `[view]`, or from the
     /// probe's centre towards the objects.
     #[arg(long, requires = "edit")]
     pub live: bool,

@@ -42,7 +42,7 @@ const DRACO: &str = "KHR_draco_mesh_compression";
 
 /// Decodes glTF 2.0 bytes, binary (`.glb`) or JSON (`.gltf`), whose buffers are all embedded (the
 /// GLB binary chunk or base64 `data:` URIs); a buffer in an external file is
-/// [`DecodeError::Unsupported`] here ([`read_mesh`] resolves those next to the file). The mesh is
+/// [`DecodeError::Unsupported`] here ([`super::read_mesh`] resolves those next to the file). The mesh is
 /// validated. Never panics; allocations are bounded by `limits` and the input size.
 pub fn decode_gltf(bytes: &[u8], limits: &MeshLimits) -> Result<LoadedMesh, DecodeError> {
     decode_gltf_in(bytes, None, limits)

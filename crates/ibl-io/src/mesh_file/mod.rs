@@ -3,13 +3,13 @@
 //! models are +Y up with metres as units, OBJ units are whatever the file used) plus one linear
 //! base colour per material group.
 //!
-//! One module per format: [`gltf`](self::gltf) (glTF 2.0, JSON or binary) and [`obj`] (Wavefront OBJ with its
+//! One module per format: `gltf` (glTF 2.0, JSON or binary) and `obj` (Wavefront OBJ with its
 //! `.mtl`); this module holds what both share: the limits, the result, the dispatch by extension
 //! and the final checks.
 //!
 //! Normals are kept only when every triangle's corners have one (and none is zero-length);
 //! otherwise the mesh gets none and is shaded flat, with a note in [`LoadedMesh::details`]. No
-//! normals are ever computed. Finally [`TriangleMesh::validate`] refuses out-of-range indices and
+//! normals are ever computed. Finally [`ibl_scene::mesh::TriangleMesh::validate`] refuses out-of-range indices and
 //! non-finite data and drops zero-area triangles.
 //!
 //! Cost: one pass over the file, O(bytes + vertices + triangles) time (plus a hash map lookup per
