@@ -604,32 +604,26 @@ fn region_spread(probe: &Image<Rgb>, grid: &Grid, r: &PixelRegion, dir: DVec3) -
         });
         h.add_pixels(keys, o);
     };
-    let chunk = |y0: usize| {
+    let histogram_of = |rows: std::ops::Range<usize>| {
         let mut h = SpreadHistogram::new();
         let mut keys = Vec::with_capacity(r.width());
-        for j in y0..(y0 + SPREAD_ROWS).min(r.y1) {
+        for j in rows {
             add_row(&mut h, &mut keys, j);
         }
         h
     };
-    let starts = (r.y0..r.y1).step_by(SPREAD_ROWS);
     let histogram = if r.width() * r.height() > PARALLEL_AREA {
+        let starts: Vec<usize> = (r.y0..r.y1).step_by(SPREAD_ROWS).collect();
         let parts: Vec<SpreadHistogram> = starts
-            .collect::<Vec<_>>()
             .into_par_iter()
-            .map(chunk)
+            .map(|y0| histogram_of(y0..(y0 + SPREAD_ROWS).min(r.y1)))
             .collect();
         parts.iter().fold(SpreadHistogram::new(), |mut all, h| {
             all.merge(h);
             all
         })
     } else {
-        let mut h = SpreadHistogram::new();
-        let mut keys = Vec::with_capacity(r.width());
-        for j in r.y0..r.y1 {
-            add_row(&mut h, &mut keys, j);
-        }
-        h
+        histogram_of(r.y0..r.y1)
     };
     histogram.spread_sr()
 }
