@@ -76,7 +76,8 @@ impl Light {
     /// in the hybrid's ambient: its measured spread where known, but never more than its
     /// source's solid angle (a long thin region spreads one way only, and an isotropic cone of
     /// its spread blurs shadows the other way too: on the bundled apartment scene median cut's
-    /// relative MSE rose from 3.0e-3 to 4.8e-3 at 16 lights without the bound), else the source's
+    /// relative MSE rose from 3.0e-3 to 4.8e-3 at 16 lights without the bound, measured with a
+    /// first, second-moment spread), else the source's
     /// solid angle.
     pub fn shadow_solid_angle_sr(&self) -> f64 {
         self.spread_sr
