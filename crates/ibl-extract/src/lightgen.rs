@@ -204,7 +204,6 @@ pub fn lightgen(
             *sc += pc;
         }
         s.solid_angle += p.solid_angle;
-        s.extent += p.extent;
     }
     let mut lights: Vec<(f64, Light)> = sums
         .iter()
