@@ -21,7 +21,8 @@
 //!
 //! Texel look-up uses `theta = atan2(sqrt(x^2 + z^2), y)`, well conditioned at the poles, and
 //! `phi = atan2(x, -z)` in f64. Cost: O(W H) to build (rows in parallel, sums in f64 per row),
-//! O(log W + log H) per sample, O(1) per radiance or density look-up.
+//! O(1) expected per sample (the guided inversion of [`Distribution1D`]), O(1) per radiance or
+//! density look-up.
 
 use std::f64::consts::{PI, TAU};
 
@@ -186,7 +187,8 @@ impl EnvironmentLight {
     /// The texel `(column, row)` a world direction falls in (the direction need not be unit).
     pub fn texel_of(&self, dir_world: Vec3) -> (usize, usize) {
         let d: DVec3 = (self.probe_from_world * dir_world).as_dvec3();
-        let theta = d.x.hypot(d.z).atan2(d.y);
+        // The squares of f32 values are exact in f64 and cannot overflow: no need for `hypot`.
+        let theta = (d.x * d.x + d.z * d.z).sqrt().atan2(d.y);
         let phi = d.x.atan2(-d.z);
         let (w, h) = (self.latlong.width, self.latlong.height);
         let mut u = phi / TAU + 0.5;
@@ -207,11 +209,19 @@ impl EnvironmentLight {
 
     /// Density (1/sr) with which [`EnvironmentLight::sample`] draws `dir_world`.
     pub fn pdf(&self, dir_world: Vec3) -> f32 {
-        if !self.importance {
-            return UniformCone::SPHERE.pdf();
-        }
+        self.radiance_and_pdf(dir_world).1
+    }
+
+    /// [`EnvironmentLight::radiance`] and [`EnvironmentLight::pdf`] of one direction, finding
+    /// its texel once.
+    pub fn radiance_and_pdf(&self, dir_world: Vec3) -> (Rgb, f32) {
         let (i, j) = self.texel_of(dir_world);
-        self.texel_pdf(i, j)
+        let pdf = if self.importance {
+            self.texel_pdf(i, j)
+        } else {
+            UniformCone::SPHERE.pdf()
+        };
+        (self.radiance[j * self.latlong.width + i], pdf)
     }
 
     fn texel_pdf(&self, i: usize, j: usize) -> f32 {
@@ -221,7 +231,8 @@ impl EnvironmentLight {
     }
 
     /// A direction drawn with density proportional to luminance (uniform within a texel) from
-    /// `u1, u2` in `[0, 1)`: `u1` picks the row, `u2` the column. O(log W + log H).
+    /// `u1, u2` in `[0, 1)`: `u1` picks the row, `u2` the column. O(1) expected, O(log W +
+    /// log H) at worst.
     pub fn sample(&self, u1: f32, u2: f32) -> EnvSample {
         let chosen = if self.importance {
             self.marginal.sample(u1).and_then(|row| {

@@ -382,11 +382,21 @@ fn clamped_cosine_integral(omc: f64, cos_beta: f64) -> f64 {
 }
 
 /// A discrete distribution over `n` cells proportional to non-negative weights, sampled by
-/// inverting its cumulative distribution (binary search).
+/// inverting its cumulative distribution.
+///
+/// The inversion is a binary search narrowed by a guide table (the cutpoint method, Chen & Asau
+/// 1974; Devroye, *Non-Uniform Random Variate Generation*, section III.2.4): for `G` (the
+/// largest power of two not above `n`) equal steps of `u`, the table holds the cell where each
+/// step starts, so a draw searches only the cells its step spans, usually one or two. The answer
+/// is the plain binary search's, bit for bit, and the map from `u` to the cell stays monotone, so
+/// low-discrepancy points keep their stratification (an alias table would not).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Distribution1D {
     /// `n + 1` non-decreasing values, `cdf[0] = 0`, `cdf[n] = 1`.
     cdf: Vec<f32>,
+    /// `G + 1` entries: `guide[k]` is the last cell `i < n` with `cdf[i] <= k / G` (exact in
+    /// f64, `G` a power of two). Empty when `n = 0`.
+    guide: Vec<u32>,
     /// Sum of the weights (f64).
     total: f64,
 }
@@ -423,11 +433,16 @@ impl Distribution1D {
                 .map(|k| (k as f64 / n.max(1) as f64) as f32)
                 .collect()
         };
-        let mut dist = Distribution1D { cdf, total: sum };
-        if let Some(last) = dist.cdf.last_mut() {
+        let mut cdf = cdf;
+        if let Some(last) = cdf.last_mut() {
             *last = 1.0;
         }
-        dist
+        let guide = guide_table(&cdf);
+        Distribution1D {
+            cdf,
+            guide,
+            total: sum,
+        }
     }
 
     /// Number of cells.
@@ -466,7 +481,13 @@ impl Distribution1D {
         } else {
             u.clamp(0.0, 1.0 - f32::EPSILON / 2.0)
         };
-        let index = (self.cdf.partition_point(|&c| c <= u) - 1).min(n - 1);
+        // The step of the guide table that `u` falls in (exact: `u` has 24 bits, `G` is a
+        // power of two below 2^32), and the cells that step spans.
+        let steps = self.guide.len() - 1;
+        let k = ((f64::from(u) * steps as f64) as usize).min(steps - 1);
+        let first = self.guide[k] as usize;
+        let last = self.guide[k + 1] as usize;
+        let index = first + self.cdf[first + 1..=last].partition_point(|&c| c <= u);
         let lo = self.cdf[index];
         let probability = self.cdf[index + 1] - lo;
         let remapped = ((u - lo) / probability).clamp(0.0, 1.0 - f32::EPSILON / 2.0);
@@ -476,6 +497,28 @@ impl Distribution1D {
             remapped,
         })
     }
+}
+
+/// The guide table of a CDF of `n + 1` entries (`cdf[0] = 0`, `cdf[n] = 1`, non-decreasing):
+/// `G + 1` entries for `G` the largest power of two `<= n`, entry `k` the last cell `i < n` with
+/// `cdf[i] <= k / G`. Empty for `n = 0`. O(n).
+fn guide_table(cdf: &[f32]) -> Vec<u32> {
+    let n = cdf.len().saturating_sub(1);
+    if n == 0 {
+        return Vec::new();
+    }
+    let steps = 1usize << n.ilog2();
+    let mut cell = 0usize;
+    (0..=steps)
+        .map(|k| {
+            let threshold = k as f64 / steps as f64;
+            while cell + 1 < n && f64::from(cdf[cell + 1]) <= threshold {
+                cell += 1;
+            }
+            // Cells are fewer than 2^32: the image limits bound `n` by 2^28.
+            u32::try_from(cell).unwrap_or(u32::MAX)
+        })
+        .collect()
 }
 
 /// Veach's power heuristic (exponent 2) for one sample from each of two techniques: the weight of
@@ -517,6 +560,40 @@ mod tests {
         assert_eq!(dist.sample(0.0).unwrap().index, 1);
         assert_eq!(dist.sample(0.25).unwrap().index, 4);
         assert_eq!(dist.sample(0.999_999_9).unwrap().index, 4);
+    }
+
+    #[test]
+    fn guided_search_equals_the_plain_binary_search() {
+        // Weights with runs of zeros, one dominant cell and tiny ones, at sizes around powers of
+        // two; `u` on a fine grid, at every CDF value and just either side of it.
+        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for n in [1usize, 2, 3, 7, 8, 9, 63, 64, 65, 500, 1024] {
+            let weights: Vec<f64> = (0..n)
+                .map(|i| match i % 7 {
+                    0 | 3 => 0.0,
+                    5 => 1e-9 * next(),
+                    _ if i == n / 2 => 1e4,
+                    _ => next(),
+                })
+                .collect();
+            let dist = Distribution1D::new(weights);
+            let plain = |u: f32| (dist.cdf.partition_point(|&c| c <= u) - 1).min(n - 1);
+            let mut us: Vec<f32> = (0..4096).map(|k| k as f32 / 4096.0).collect();
+            for &c in &dist.cdf {
+                us.extend([c, c.next_down(), c.next_up()]);
+            }
+            for u in us.into_iter().filter(|u| (0.0..1.0).contains(u)) {
+                let s = dist.sample(u).unwrap();
+                assert_eq!(s.index, plain(u), "n {n}, u {u}");
+                assert!(s.probability > 0.0 || dist.total() == 0.0, "n {n}, u {u}");
+            }
+        }
     }
 
     #[test]

@@ -520,7 +520,8 @@ impl<'a> Tracer<'a> {
             // The camera, or a mirror: the probe itself in every mode.
             (_, None) => env.radiance(direction),
             (Illumination::Environment, Some(pdf)) => {
-                env.radiance(direction) * power_heuristic(pdf, env.pdf(direction))
+                let (radiance, env_pdf) = env.radiance_and_pdf(direction);
+                radiance * power_heuristic(pdf, env_pdf)
             }
             // The lights (and the ambient) stand for the probe; their paths end at the first
             // diffuse or glossy vertex, so this arm is only reached by a BSDF sample there.
