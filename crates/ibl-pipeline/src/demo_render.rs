@@ -5,8 +5,8 @@
 //! Per scene, into `renders/<scene>/`, each at the scene's own settings for its mode
 //! (`RenderSettings::for_scene`): the reference composite (perspective view, several bounces),
 //! the same in the whole panorama, light renders with N = 4, 16 and 64 median-cut lights with soft
-//! shadows and 16 with hard shadows, the hybrid (16 lights + SH9 ambient with directional
-//! occlusion), the with/without layers of the reference, each light render with its time, its
+//! shadows and 16 with hard shadows, the hybrid (16 lights + the scene's SH ambient, 5 bands, with
+//! directional occlusion), the with/without layers of the reference, each light render with its time, its
 //! speed-up over the reference and its error against it; then the study of
 //! `ibl_eval::render_study` (methods x N = 1..256 with soft shadows, every method's hybrid at
 //! N = 16, median cut with hard shadows, against a direct-light reference) with its table in

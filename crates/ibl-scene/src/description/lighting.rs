@@ -44,7 +44,9 @@ pub struct LightingDescription {
     /// Default 0.02, in `(0, 1]`.
     #[serde(default = "default_adaptive_contrast")]
     pub adaptive_contrast: f32,
-    /// SH bands of the hybrid ambient. Default 3.
+    /// SH bands of the hybrid ambient. Default 5: the ambient's bands 3 and 4 carry the
+    /// lights' own high-band error, which 3 bands leave in every unshadowed surface
+    /// (docs/RENDERING.md, "The hybrid's bands").
     #[serde(default = "default_bands")]
     pub ambient_bands: u32,
     /// Occlusion rays per shading point and sample (hybrid). Default 4.
@@ -77,7 +79,7 @@ fn default_adaptive_contrast() -> f32 {
     0.02
 }
 fn default_bands() -> u32 {
-    3
+    5
 }
 fn default_ao() -> u32 {
     4
