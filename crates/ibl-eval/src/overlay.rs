@@ -191,6 +191,7 @@ mod tests {
             irradiance: Rgb64::new(irradiance, irradiance, irradiance),
             region,
             spread_sr: None,
+            core_fraction: None,
         }
     }
 

@@ -395,6 +395,7 @@ fn black_fit(n: usize, normals: usize) -> Fit {
             irradiance: Rgb64::ZERO,
             region: None,
             spread_sr: None,
+            core_fraction: None,
         })
         .collect();
     let report = FitReport {
@@ -706,6 +707,7 @@ impl Problem {
                     solid_angle_sr: SOURCE_SOLID_ANGLE_SR,
                     irradiance: Rgb64::from_array(irradiance),
                     spread_sr: None,
+                    core_fraction: None,
                     region: None,
                 }
             })

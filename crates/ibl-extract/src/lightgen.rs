@@ -60,7 +60,7 @@ use rand_pcg::Pcg64;
 use rayon::prelude::*;
 
 use crate::ExtractError;
-use crate::region_stats::{Grid, clamped, light};
+use crate::region_stats::{Grid, clamped, core_fraction, light};
 
 /// Clustering settings.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -228,6 +228,7 @@ pub fn lightgen(
     }
     for ((_, l), h) in lights.iter_mut().zip(&spreads) {
         l.spread_sr = h.spread_sr();
+        l.core_fraction = core_fraction(h, l);
     }
     lights.sort_by(|a, b| b.0.total_cmp(&a.0));
     Ok(LightSet {

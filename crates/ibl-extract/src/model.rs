@@ -198,6 +198,7 @@ fn sun_set(
             irradiance: sun.irradiance,
             region: None,
             spread_sr: None,
+            core_fraction: None,
         }],
     })
 }

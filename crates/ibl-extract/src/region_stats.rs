@@ -577,18 +577,28 @@ fn region_light<const SUM_MOMENT: bool>(
         .try_normalize()
         .or_else(|| geometric.try_normalize())
         .unwrap_or(DVec3::Y);
-    let spread = region_spread(probe, grid, &r, dir);
-    light(dir, power, solid_angle, spread, Some(r))
+    let histogram = region_spread(probe, grid, &r, dir);
+    let mut l = light(dir, power, solid_angle, histogram.spread_sr(), Some(r));
+    l.core_fraction = core_fraction(&histogram, &l);
+    l
+}
+
+/// A light's [`Light::core_fraction`] from the histogram of its pixels: `None` where it has no
+/// spread.
+pub(crate) fn core_fraction(histogram: &SpreadHistogram, light: &Light) -> Option<f64> {
+    light
+        .spread_sr
+        .map(|_| histogram.core_fraction(light.shadow_solid_angle_sr(), light.solid_angle_sr))
 }
 
 /// Rows per chunk of [`region_spread`]'s parallel histograms.
 const SPREAD_ROWS: usize = 16;
 
-/// The spread of region `r`'s power about `dir` (unit), sr ([`ibl_light::spread`]): a second
-/// pass over its pixels into a [`SpreadHistogram`]. A large region's rows are histogrammed in
+/// The histogram of region `r`'s power about `dir` (unit) that gives its spread and core
+/// ([`ibl_light::spread`]): a second pass over its pixels. A large region's rows are histogrammed in
 /// chunks of [`SPREAD_ROWS`] in parallel and merged in row order, so the result does not depend
 /// on the thread count. Cost O(area).
-fn region_spread(probe: &Image<Rgb>, grid: &Grid, r: &PixelRegion, dir: DVec3) -> Option<f64> {
+fn region_spread(probe: &Image<Rgb>, grid: &Grid, r: &PixelRegion, dir: DVec3) -> SpreadHistogram {
     // Per row: the keys and luminances first (a loop the compiler can vectorise), then the
     // histogram's runs.
     let add_row = |h: &mut SpreadHistogram, keys: &mut Vec<(f64, f64)>, j: usize| {
@@ -612,7 +622,7 @@ fn region_spread(probe: &Image<Rgb>, grid: &Grid, r: &PixelRegion, dir: DVec3) -
         }
         h
     };
-    let histogram = if r.width() * r.height() > PARALLEL_AREA {
+    if r.width() * r.height() > PARALLEL_AREA {
         let starts: Vec<usize> = (r.y0..r.y1).step_by(SPREAD_ROWS).collect();
         let parts: Vec<SpreadHistogram> = starts
             .into_par_iter()
@@ -624,8 +634,7 @@ fn region_spread(probe: &Image<Rgb>, grid: &Grid, r: &PixelRegion, dir: DVec3) -
         })
     } else {
         histogram_of(r.y0..r.y1)
-    };
-    histogram.spread_sr()
+    }
 }
 
 /// A light from its direction (unit), power per channel (probe unit x sr), solid angle (sr) and
@@ -653,5 +662,6 @@ pub(crate) fn light(
         irradiance: Rgb64::from_array(power),
         region,
         spread_sr: spread,
+        core_fraction: None,
     }
 }

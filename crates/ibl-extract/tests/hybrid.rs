@@ -48,6 +48,7 @@ fn sun_light(probe: &Image<Rgb>) -> LightSet {
             irradiance: sun.irradiance,
             region: None,
             spread_sr: None,
+            core_fraction: None,
         }],
     }
 }

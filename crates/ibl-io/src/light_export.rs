@@ -22,7 +22,8 @@
 //!   make the brightest light match a measured illuminance. A black light gets `color = [1, 1, 1]`
 //!   and `intensity = 0`. `I` and `A` are also kept in each light's `extras`, with the solid
 //!   angle of the cone its soft shadow is sized by (`shadow_solid_angle`, the light's spread
-//!   within `A`).
+//!   within `A`) and the share of its power in that cone (`shadow_core_fraction`; the rest
+//!   spreads over `A`).
 //! - **Mitsuba 3**: `<emitter type="directional">` with `direction = p` (Mitsuba's `direction` is
 //!   the way the light radiates) and `irradiance = I` as `<rgb>`.
 //! - **pbrt-v4**: `LightSource "distant"` with `from = direction`, `to = 0` (pbrt's light travels
@@ -297,6 +298,7 @@ fn gltf_value(lights: &[Light], options: &ExportOptions) -> Result<serde_json::V
                 "illuminance_lux": s * luminance(c.irradiance),
                 "solid_angle": record.solid_angle_sr,
                 "shadow_solid_angle": record.shadow_solid_angle_sr(),
+                "shadow_core_fraction": record.core_fraction.unwrap_or(1.0),
             },
         }));
         nodes.push(json!({
@@ -531,6 +533,7 @@ mod tests {
             irradiance: Rgb64::from_array(irradiance),
             region: None,
             spread_sr: None,
+            core_fraction: None,
         }
     }
 
@@ -613,6 +616,7 @@ mod tests {
             assert!((y - lux * luminance(l.irradiance.to_array())).abs() < 1e-9);
             assert!((f(&light["extras"]["illuminance_lux"]) - y).abs() < 1e-9);
             assert_eq!(f(&light["extras"]["shadow_solid_angle"]), 0.01);
+            assert_eq!(f(&light["extras"]["shadow_core_fraction"]), 1.0);
         }
     }
 

@@ -240,13 +240,15 @@ pub fn light_set_from_json(path: &Path, bytes: &[u8]) -> Result<LightSet, IoErro
             && l.solid_angle_sr.is_finite()
             && l.solid_angle_sr >= 0.0
             && l.spread_sr
-                .is_none_or(|a| a.is_finite() && (0.0..=4.0 * std::f64::consts::PI).contains(&a));
+                .is_none_or(|a| a.is_finite() && (0.0..=4.0 * std::f64::consts::PI).contains(&a))
+            && l.core_fraction.is_none_or(|f| (0.0..=1.0).contains(&f));
         if !ok {
             return Err(IoError::Invalid {
                 path: path.to_path_buf(),
                 reason: format!(
                     "light {i}: direction must be a unit vector, irradiance and solid angle \
-                     finite and non-negative, and spread (if given) from 0 to 4 pi sr"
+                     finite and non-negative, spread (if given) from 0 to 4 pi sr and \
+                     core_fraction (if given) from 0 to 1"
                 ),
             });
         }
@@ -296,6 +298,7 @@ mod tests {
                         y1: 3,
                     }),
                     spread_sr: Some(0.25),
+                    core_fraction: Some(0.75),
                 }],
             },
             frame,
@@ -320,6 +323,7 @@ mod tests {
         assert!(text.contains("\"converged\": 1,") && text.contains("\"iterations\": 3,"));
         assert!(text.contains("\"solid_angle\": 0.5") && text.contains("\"x1\": 2"));
         assert!(text.contains("\"spread\": 0.25"), "{text}");
+        assert!(text.contains("\"core_fraction\": 0.75"), "{text}");
         assert!(!text.contains("ambient"));
     }
 
@@ -346,6 +350,14 @@ mod tests {
         write_lights_file(&path, &bad).expect("writes");
         let e = read_light_set(&path).unwrap_err();
         assert!(e.is_bad_input() && e.to_string().contains("light 0"), "{e}");
+        let mut bad = file(FramePreset::Gltf);
+        bad.set.lights[0].core_fraction = Some(1.5);
+        write_lights_file(&path, &bad).expect("writes");
+        let e = read_light_set(&path).unwrap_err();
+        assert!(
+            e.is_bad_input() && e.to_string().contains("core_fraction"),
+            "{e}"
+        );
         std::fs::write(&path, b"{\"format\": \"other/1\"}").expect("writes");
         assert!(read_lights_file(&path).is_err_and(|e| e.is_bad_input()));
     }

@@ -69,6 +69,23 @@ pub struct Light {
     /// `None` where not measured.
     #[serde(default, rename = "spread", skip_serializing_if = "Option::is_none")]
     pub spread_sr: Option<f64>,
+    /// The fraction (0 to 1) of the light's power in the core of its spread, the rest spread
+    /// as a halo over its source's `solid_angle` ([`crate::spread`], "A core and a halo"): a
+    /// sun inside a cluster of sky keeps the sky's share out of the sun's shadow. Measured
+    /// with the spread; `None` (all core) where not measured.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub core_fraction: Option<f64>,
+}
+
+/// The two uniform cones about a light's direction that stand for it in soft shadows and in the
+/// hybrid's ambient ([`Light::shadow_cones`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShadowCones {
+    /// Solid angle (sr) of the core.
+    pub core_sr: f64,
+    /// The halo: its solid angle (sr, larger than the core's) and its share of the power in
+    /// `(0, 1]`; `None` when the core holds it all.
+    pub halo: Option<(f64, f64)>,
 }
 
 impl Light {
@@ -82,6 +99,18 @@ impl Light {
     pub fn shadow_solid_angle_sr(&self) -> f64 {
         self.spread_sr
             .map_or(self.solid_angle_sr, |s| s.min(self.solid_angle_sr))
+    }
+
+    /// The core ([`Light::shadow_solid_angle_sr`]) and, where the light has a measured
+    /// [`Light::core_fraction`] below 1 and a source wider than its core, the halo of its
+    /// source's solid angle holding the rest of the power.
+    pub fn shadow_cones(&self) -> ShadowCones {
+        let core_sr = self.shadow_solid_angle_sr();
+        let halo = self.core_fraction.and_then(|f| {
+            (f.is_finite() && (0.0..1.0).contains(&f) && self.solid_angle_sr > core_sr)
+                .then_some((self.solid_angle_sr, 1.0 - f))
+        });
+        ShadowCones { core_sr, halo }
     }
 }
 
@@ -170,6 +199,7 @@ mod tests {
                     irradiance: Rgb64::new(0.5, 1.0, 1.5),
                     region: None,
                     spread_sr: None,
+                    core_fraction: None,
                 },
                 Light {
                     direction: DVec3::NEG_Z,
@@ -183,6 +213,7 @@ mod tests {
                         y1: 8,
                     }),
                     spread_sr: Some(0.125),
+                    core_fraction: None,
                 },
             ],
         }
@@ -195,6 +226,17 @@ mod tests {
         assert_eq!(s.lights[1].shadow_solid_angle_sr(), 0.125);
         s.lights[1].spread_sr = Some(2.0);
         assert_eq!(s.lights[1].shadow_solid_angle_sr(), 0.25);
+        // A halo only with a core fraction below 1 and a source wider than the core.
+        assert_eq!(s.lights[1].shadow_cones().halo, None);
+        s.lights[1].spread_sr = Some(0.125);
+        s.lights[1].core_fraction = Some(0.75);
+        let cones = s.lights[1].shadow_cones();
+        assert_eq!((cones.core_sr, cones.halo), (0.125, Some((0.25, 0.25))));
+        s.lights[1].core_fraction = Some(1.0);
+        assert_eq!(s.lights[1].shadow_cones().halo, None);
+        s.lights[1].core_fraction = Some(0.5);
+        s.lights[1].spread_sr = Some(0.5);
+        assert_eq!(s.lights[1].shadow_cones().halo, None);
     }
 
     #[test]

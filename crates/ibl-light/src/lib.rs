@@ -31,7 +31,7 @@ pub mod provenance;
 pub mod spread;
 
 pub use daylight::{Sky, Sun};
-pub use directional::{Light, LightSet, PixelRegion};
+pub use directional::{Light, LightSet, PixelRegion, ShadowCones};
 pub use goniometric::equal_area::EqualAreaMap;
 pub use goniometric::{CandelaTable, GoniometricLight, PhotometryError, intensity_per_candela_for};
 pub use method::{LightSource, MAX_MEDIAN_CUT_SPLITS, Method, MethodError};

@@ -62,6 +62,7 @@ impl AreaPatch {
             irradiance,
             region: None,
             spread_sr: None,
+            core_fraction: None,
         })
     }
 }

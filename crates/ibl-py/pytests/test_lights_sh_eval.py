@@ -36,6 +36,10 @@ def test_every_method_makes_lights_that_keep_the_power(sky, method):
         # The sky's sun: its light spreads over far less than its region.
         sun = int(np.argmax(lights.irradiance.sum(axis=1)))
         assert shadow[sun] < 0.5 * lights.solid_angles[sun]
+        # Most of the sun's light is in that core; the rest is sky spread over its region.
+        core = lights.shadow_core_fractions
+        assert np.all((core >= 0.0) & (core <= 1.0))
+        assert core[sun] > 0.5
 
 
 def test_lights_equal_the_cli_file(tmp_path, sky, ibl):

@@ -70,6 +70,19 @@ impl PyLightSet {
         Array1::from(v).into_pyarray(py)
     }
 
+    /// Share of each light's power in that cone (its core), (N,): the rest spreads as a halo
+    /// over the light's solid angle; 1 where the method measures no spread.
+    #[getter]
+    fn shadow_core_fractions<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        let v: Vec<f64> = self
+            .set
+            .lights
+            .iter()
+            .map(|l| l.shadow_cones().halo.map_or(1.0, |(_, share)| 1.0 - share))
+            .collect();
+        Array1::from(v).into_pyarray(py)
+    }
+
     /// The extraction method's name.
     #[getter]
     fn method(&self) -> String {

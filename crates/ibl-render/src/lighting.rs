@@ -60,10 +60,45 @@ pub struct DirectionalLight {
     pub direction: Vec3,
     /// `I = L A`: irradiance on a surface facing the light, per channel.
     pub irradiance: Rgb,
-    /// The cone of the light's solid angle (soft shadows), `None` for a point-like light.
+    /// The cone of the light's solid angle (soft shadows), `None` for a point-like light: its
+    /// core ([`ibl_light::Light::shadow_cones`]).
     pub cone: Option<UniformCone>,
+    /// The halo around the core and its share of the light in `(0, 1]`, where the light has one
+    /// (a sun held with sky around it: [`ibl_light::spread`], "A core and a halo"). Soft shadows
+    /// and the hybrid's ambient take the light as the two cones, weighted by their shares.
+    pub halo: Option<(UniformCone, f32)>,
     /// The basis about `direction` in which the cone is sampled.
     pub frame: OrthonormalBasis,
+}
+
+impl DirectionalLight {
+    /// A point of the light's soft shadow, uniform in its core (`cone`) with probability `1 -
+    /// s` and in its halo with `s`, from `u1, u2` in `[0, 1)` (`u1` picks the cone and is
+    /// rescaled, so stratified points stay stratified); world frame. `None` without a cone.
+    pub fn shadow_point(&self, u1: f32, u2: f32) -> Option<Vec3> {
+        let core = self.cone?;
+        let below_one = |u: f32| u.clamp(0.0, 1.0 - f32::EPSILON / 2.0);
+        let local = match self.halo {
+            Some((halo, share)) if u1 < share => halo.sample(below_one(u1 / share), u2),
+            Some((_, share)) => core.sample(below_one((u1 - share) / (1.0 - share)), u2),
+            None => core.sample(u1, u2),
+        };
+        Some(self.frame.to_world(local))
+    }
+
+    /// The mean clamped cosine of the light's cones (shares as weights) to a normal at
+    /// `cos_beta` from its direction ([`UniformCone::mean_clamped_cosine`]); `cos_beta`
+    /// clamped at 0 without a cone.
+    pub fn mean_clamped_cosine(&self, cos_beta: f32) -> f32 {
+        match (self.cone, self.halo) {
+            (Some(core), Some((halo, share))) => {
+                (1.0 - share) * core.mean_clamped_cosine(cos_beta)
+                    + share * halo.mean_clamped_cosine(cos_beta)
+            }
+            (Some(core), None) => core.mean_clamped_cosine(cos_beta),
+            (None, _) => cos_beta.max(0.0),
+        }
+    }
 }
 
 /// The directional part of the `lights` and `hybrid` modes.
@@ -225,16 +260,25 @@ impl Lighting {
 }
 
 /// `ambient + sum_i I_i (1 - g_l(c_i)) Y_lm(w_i)`: a point-subtracted ambient turned into the
-/// ambient of the same lights as uniform cones (module notes), probe frame.
+/// ambient of the same lights as uniform cones (module notes; a light with a halo as its two
+/// cones, `g_l` the share-weighted mean of theirs), probe frame.
 fn with_cones_spread(ambient: &RadianceSh, lights: &LightSet) -> RadianceSh {
     let bands = ambient.bands();
     let mut coefficients = ambient.coefficients().to_vec();
     for light in &lights.lights {
-        let a = light.shadow_solid_angle_sr();
+        let cones = light.shadow_cones();
+        let a = cones.core_sr;
         if !(a.is_finite() && a > 0.0) {
             continue;
         }
-        let factors = cap_zonal_factors((a / TAU).min(2.0), bands);
+        let mut factors = cap_zonal_factors((a / TAU).min(2.0), bands);
+        if let Some((halo_sr, share)) = cones.halo {
+            // The light as its two cones: each cap's factors weighted by its share.
+            let halo = cap_zonal_factors((halo_sr / TAU).min(2.0), bands);
+            for (g, h) in factors.iter_mut().zip(halo) {
+                *g = (1.0 - share) * *g + share * h;
+            }
+        }
         let y = basis(light.direction, bands);
         let power = [light.irradiance.r, light.irradiance.g, light.irradiance.b];
         for (l, g) in factors.iter().enumerate() {
@@ -286,7 +330,8 @@ impl LightList {
     /// The renderer's lights of `set` (its frame turned to the world by `world_from_set`): black
     /// lights dropped, each with the cone of its shadow solid angle (soft shadows): its spread
     /// where the extraction measured it, else its solid angle `A_i`
-    /// ([`ibl_light::Light::shadow_solid_angle_sr`]).
+    /// ([`ibl_light::Light::shadow_solid_angle_sr`]), and its halo where it has one
+    /// ([`ibl_light::Light::shadow_cones`]).
     pub fn from_set(set: &LightSet, world_from_set: DMat3, shadows: ShadowKind) -> LightList {
         let lights: Vec<DirectionalLight> = set
             .lights
@@ -296,6 +341,7 @@ impl LightList {
                 let direction = (world_from_set * l.direction)
                     .normalize_or(DVec3::Y)
                     .as_vec3();
+                let cones = l.shadow_cones();
                 DirectionalLight {
                     direction,
                     irradiance: Rgb::new(
@@ -303,7 +349,10 @@ impl LightList {
                         l.irradiance.g as f32,
                         l.irradiance.b as f32,
                     ),
-                    cone: UniformCone::from_solid_angle(l.shadow_solid_angle_sr() as f32),
+                    cone: UniformCone::from_solid_angle(cones.core_sr as f32),
+                    halo: cones.halo.and_then(|(sr, share)| {
+                        UniformCone::from_solid_angle(sr as f32).map(|c| (c, share as f32))
+                    }),
                     frame: OrthonormalBasis::from_normal(direction),
                 }
             })

@@ -313,7 +313,17 @@ impl ConeShading {
 
     /// The table of `cone`.
     pub fn new(cone: UniformCone) -> ConeShading {
-        let omc = f64::from(cone.one_minus_cos);
+        ConeShading::mixture(cone, None)
+    }
+
+    /// The table of a light's two cones ([`crate::lighting::DirectionalLight::halo`]): the core
+    /// `core` with the share `1 - s` of the light and the halo with `s`, the mean of the two
+    /// weighted by their shares, tabulated across the wider one's band (the same interpolation
+    /// error bound: each cone's is under 1e-4 of its light).
+    pub fn mixture(core: UniformCone, halo: Option<(UniformCone, f32)>) -> ConeShading {
+        let (halo_cone, share) = halo.unwrap_or((core, 0.0));
+        let widest = core.one_minus_cos.max(halo_cone.one_minus_cos);
+        let omc = f64::from(widest);
         let cos_a = 1.0 - omc;
         let (lo, hi) = if cos_a > 0.0 {
             let sin_a = (omc * (2.0 - omc)).sqrt();
@@ -321,16 +331,18 @@ impl ConeShading {
         } else {
             (-1.0, 1.0)
         };
+        let mean = |c: f32| {
+            (1.0 - share) * core.mean_clamped_cosine(c) + share * halo_cone.mean_clamped_cosine(c)
+        };
         let table = (0..=Self::STEPS)
-            .map(|k| {
-                let c = lo + (hi - lo) * k as f64 / Self::STEPS as f64;
-                cone.mean_clamped_cosine(c as f32)
-            })
+            .map(|k| mean((lo + (hi - lo) * k as f64 / Self::STEPS as f64) as f32))
             .collect();
+        let slope = |cone: UniformCone| 1.0 - 0.5 * f64::from(cone.one_minus_cos);
         ConeShading {
             lo: lo as f32,
             hi: hi as f32,
-            slope: (1.0 - 0.5 * omc) as f32,
+            slope: ((1.0 - f64::from(share)) * slope(core) + f64::from(share) * slope(halo_cone))
+                as f32,
             table,
             wide: cos_a <= 0.0,
         }
@@ -745,6 +757,22 @@ mod tests {
         let mean = sum / (k * k) as f64;
         let got = f64::from(cone.mean_clamped_cosine(0.9f32.cos()));
         assert!((got - mean).abs() < 1e-4, "{got} against {mean}");
+    }
+
+    #[test]
+    fn a_mixtures_table_is_the_weighted_closed_form() {
+        let core = UniformCone::from_half_angle(0.01).unwrap();
+        for (halo_angle, share) in [(0.3f32, 0.1f32), (0.8, 0.4), (1.9, 0.05)] {
+            let halo = UniformCone::from_half_angle(halo_angle).unwrap();
+            let table = ConeShading::mixture(core, Some((halo, share)));
+            for k in 0..=20_000 {
+                let c = -1.0 + 2.0 * k as f32 / 20_000.0;
+                let exact = (1.0 - share) * core.mean_clamped_cosine(c)
+                    + share * halo.mean_clamped_cosine(c);
+                let err = (table.mean_clamped_cosine(c) - exact).abs();
+                assert!(err < 1e-4, "{halo_angle} {share} at {c}: {err}");
+            }
+        }
     }
 
     #[test]

@@ -367,7 +367,7 @@ impl<'a> Tracer<'a> {
             {
                 list.lights
                     .iter()
-                    .map(|l| l.cone.map(ConeShading::new))
+                    .map(|l| l.cone.map(|core| ConeShading::mixture(core, l.halo)))
                     .collect()
             }
             _ => Vec::new(),
@@ -584,12 +584,12 @@ impl<'a> Tracer<'a> {
         let surface = vertex.surface;
         for (index, light) in list.lights.iter().enumerate() {
             match (list.shadows, light.cone) {
-                (ShadowKind::Soft, Some(cone)) => {
+                (ShadowKind::Soft, Some(_)) => {
                     let axis = light.direction;
                     let cos_beta = surface.shading_normal.dot(axis);
                     let mean_cos = match &self.cone_shading.get(index) {
                         Some(Some(table)) => table.mean_clamped_cosine(cos_beta),
-                        _ => cone.mean_clamped_cosine(cos_beta),
+                        _ => light.mean_clamped_cosine(cos_beta),
                     };
                     let f = cone_bsdf(vertex, axis, cos_beta);
                     if mean_cos <= 0.0 || f.max_channel() <= 0.0 {
@@ -609,7 +609,9 @@ impl<'a> Tracer<'a> {
                     // ray finds blocked is taken off where it is blocked.
                     sum.add_all(light_value * mean_cos);
                     let [u1, u2] = stream.next_2d();
-                    let point = light.frame.to_world(cone.sample(u1, u2));
+                    let Some(point) = light.shadow_point(u1, u2) else {
+                        continue;
+                    };
                     let cos = surface.shading_normal.dot(point);
                     if cos <= 0.0 {
                         // Below the shading surface the cone adds nothing: nothing to take off.

@@ -124,6 +124,7 @@ fn one_light(direction: DVec3, irradiance: [f64; 3], solid_angle_sr: f64) -> Lig
             irradiance: Rgb64::from_array(irradiance),
             region: None,
             spread_sr: None,
+            core_fraction: None,
         }],
     }
 }
@@ -974,4 +975,48 @@ fn soft_shadow_cones_take_each_lights_spread_within_its_solid_angle() {
     assert!((cone_sr(&set) - 0.01).abs() < 1e-7);
     set.lights[0].spread_sr = Some(3.0);
     assert!((cone_sr(&set) - 0.5).abs() < 1e-6);
+}
+
+#[test]
+fn a_light_with_a_core_fraction_shadows_as_a_core_and_a_halo() {
+    // A light of solid angle 0.5 sr whose spread is 0.01 sr with 75 % of its power in it: the
+    // renderer's light is a core of 0.01 sr and a halo of 0.5 sr holding a quarter.
+    let mut set = one_light(DVec3::Y, [1.0; 3], 0.5);
+    set.lights[0].spread_sr = Some(0.01);
+    set.lights[0].core_fraction = Some(0.75);
+    let list =
+        ibl_render::lighting::LightList::from_set(&set, glam::DMat3::IDENTITY, ShadowKind::Soft);
+    let light = list.lights[0];
+    let core = light.cone.expect("a core");
+    let (halo, share) = light.halo.expect("a halo");
+    assert!((core.solid_angle() - 0.01).abs() < 1e-7);
+    assert!((halo.solid_angle() - 0.5).abs() < 1e-6 && (share - 0.25).abs() < 1e-7);
+    // Its shadow points: a quarter of a stratified set falls outside the core (the halo's
+    // points inside the core's cone, 0.01 / 0.5 of them, count as inside), each point unit.
+    let cos_core = 1.0 - 0.01 / std::f32::consts::TAU;
+    let n = 4000;
+    let outside = (0..n)
+        .filter(|&k| {
+            let u1 = (k as f32 + 0.5) / n as f32;
+            let p = light.shadow_point(u1, 0.37).expect("a point");
+            assert!((p.length() - 1.0).abs() < 1e-5);
+            p.y < cos_core
+        })
+        .count();
+    let expected = 0.25 * (1.0 - 0.01 / 0.5) * n as f32;
+    assert!(
+        (outside as f32 - expected).abs() <= 2.0,
+        "{outside} {expected}"
+    );
+    // Its unshadowed cosine is the two cones' means weighted by their shares.
+    for cos_beta in [1.0f32, 0.5, 0.1, -0.05, -0.5] {
+        let want =
+            0.75 * core.mean_clamped_cosine(cos_beta) + 0.25 * halo.mean_clamped_cosine(cos_beta);
+        assert!((light.mean_clamped_cosine(cos_beta) - want).abs() < 1e-7);
+    }
+    // All core: no halo.
+    set.lights[0].core_fraction = Some(1.0);
+    let list =
+        ibl_render::lighting::LightList::from_set(&set, glam::DMat3::IDENTITY, ShadowKind::Soft);
+    assert_eq!(list.lights[0].halo, None);
 }

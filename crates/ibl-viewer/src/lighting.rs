@@ -292,6 +292,7 @@ mod tests {
                     y1: 4,
                 }),
                 spread_sr: None,
+                core_fraction: None,
             }],
         };
         let mask = region_borders(&set, 8, 6).expect("a region");

@@ -516,6 +516,7 @@ mod tests {
             direction: Vec3::Y,
             irradiance: ibl_core::Rgb::ONE,
             cone: ibl_render::sampling::UniformCone::from_solid_angle(solid_angle),
+            halo: None,
             frame: ibl_render::sampling::OrthonormalBasis::from_normal(Vec3::Y),
         };
         assert_eq!(cone_tangent(&light(0.0)), 0.0);
