@@ -313,17 +313,7 @@ impl ConeShading {
 
     /// The table of `cone`.
     pub fn new(cone: UniformCone) -> ConeShading {
-        ConeShading::mixture(cone, None)
-    }
-
-    /// The table of a light's two cones ([`crate::lighting::DirectionalLight::halo`]): the core
-    /// `core` with the share `1 - s` of the light and the halo with `s`, the mean of the two
-    /// weighted by their shares, tabulated across the wider one's band (the same interpolation
-    /// error bound: each cone's is under 1e-4 of its light).
-    pub fn mixture(core: UniformCone, halo: Option<(UniformCone, f32)>) -> ConeShading {
-        let (halo_cone, share) = halo.unwrap_or((core, 0.0));
-        let widest = core.one_minus_cos.max(halo_cone.one_minus_cos);
-        let omc = f64::from(widest);
+        let omc = f64::from(cone.one_minus_cos);
         let cos_a = 1.0 - omc;
         let (lo, hi) = if cos_a > 0.0 {
             let sin_a = (omc * (2.0 - omc)).sqrt();
@@ -331,18 +321,16 @@ impl ConeShading {
         } else {
             (-1.0, 1.0)
         };
-        let mean = |c: f32| {
-            (1.0 - share) * core.mean_clamped_cosine(c) + share * halo_cone.mean_clamped_cosine(c)
-        };
         let table = (0..=Self::STEPS)
-            .map(|k| mean((lo + (hi - lo) * k as f64 / Self::STEPS as f64) as f32))
+            .map(|k| {
+                let c = lo + (hi - lo) * k as f64 / Self::STEPS as f64;
+                cone.mean_clamped_cosine(c as f32)
+            })
             .collect();
-        let slope = |cone: UniformCone| 1.0 - 0.5 * f64::from(cone.one_minus_cos);
         ConeShading {
             lo: lo as f32,
             hi: hi as f32,
-            slope: ((1.0 - f64::from(share)) * slope(core) + f64::from(share) * slope(halo_cone))
-                as f32,
+            slope: (1.0 - 0.5 * omc) as f32,
             table,
             wide: cos_a <= 0.0,
         }
@@ -365,6 +353,38 @@ impl ConeShading {
         let k = (x as usize).min(Self::STEPS - 1);
         let t = x - k as f32;
         self.table[k] + (self.table[k + 1] - self.table[k]) * t
+    }
+}
+
+/// A light's cones ([`crate::lighting::DirectionalLight`]: its core, and its halo with its
+/// share `s` of the light) as [`ConeShading`] tables: the mean clamped cosine `(1 - s)
+/// mean_core + s mean_halo`, each table within its own bound (1e-4 of its cone's light). Each
+/// cone keeps its own table, so a narrow core is not read at a wide halo's step.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LightShading {
+    core: ConeShading,
+    halo: Option<(ConeShading, f32)>,
+}
+
+impl LightShading {
+    /// The tables of `core` and of the halo `(cone, share)`, if any.
+    pub fn new(core: UniformCone, halo: Option<(UniformCone, f32)>) -> LightShading {
+        LightShading {
+            core: ConeShading::new(core),
+            halo: halo.map(|(cone, share)| (ConeShading::new(cone), share)),
+        }
+    }
+
+    /// The light's mean clamped cosine to a normal at `cos_beta` from its axis.
+    #[inline]
+    pub fn mean_clamped_cosine(&self, cos_beta: f32) -> f32 {
+        let core = self.core.mean_clamped_cosine(cos_beta);
+        match &self.halo {
+            Some((halo, share)) => {
+                (1.0 - share) * core + share * halo.mean_clamped_cosine(cos_beta)
+            }
+            None => core,
+        }
     }
 }
 
@@ -764,7 +784,7 @@ mod tests {
         let core = UniformCone::from_half_angle(0.01).unwrap();
         for (halo_angle, share) in [(0.3f32, 0.1f32), (0.8, 0.4), (1.9, 0.05)] {
             let halo = UniformCone::from_half_angle(halo_angle).unwrap();
-            let table = ConeShading::mixture(core, Some((halo, share)));
+            let table = LightShading::new(core, Some((halo, share)));
             for k in 0..=20_000 {
                 let c = -1.0 + 2.0 * k as f32 / 20_000.0;
                 let exact = (1.0 - share) * core.mean_clamped_cosine(c)

@@ -58,7 +58,7 @@ use ibl_scene::{Hit, Ray, Scene, ShadowKind, SurfacePoint};
 use crate::lighting::{Ambient, Illumination, LightList, Lighting};
 use crate::material::Bsdf;
 use crate::sampler::SampleStream;
-use crate::sampling::{ConeShading, OrthonormalBasis, power_heuristic, sample_cosine_hemisphere};
+use crate::sampling::{LightShading, OrthonormalBasis, power_heuristic, sample_cosine_hemisphere};
 
 /// Which layers a path may meet.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -312,8 +312,8 @@ pub struct Tracer<'a> {
     scene: &'a Scene,
     lighting: &'a Lighting,
     bounces: u32,
-    /// Per light of the lighting's light list, its cone's shading table (soft shadows only).
-    cone_shading: Vec<Option<ConeShading>>,
+    /// Per light of the lighting's light list, its cones' shading tables (soft shadows only).
+    cone_shading: Vec<Option<LightShading>>,
     /// Whether every real triangle lies in one plane (a ground): then no ray leaving a real
     /// surface towards its geometric normal's side can meet the real layer.
     flat_real_layer: bool,
@@ -367,7 +367,7 @@ impl<'a> Tracer<'a> {
             {
                 list.lights
                     .iter()
-                    .map(|l| l.cone.map(|core| ConeShading::mixture(core, l.halo)))
+                    .map(|l| l.cone.map(|core| LightShading::new(core, l.halo)))
                     .collect()
             }
             _ => Vec::new(),
@@ -559,7 +559,7 @@ impl<'a> Tracer<'a> {
     /// A hard light adds `f(w_o, l) cos(theta_l) I` where its ray along `l` is open. A soft light
     /// (a cone of uniform radiance `L`, `I = L A`) adds `f I (mean_cone(max(0, n . w)) - c_s
     /// (1 - V(w_s)))`: its unshadowed light exact
-    /// ([`crate::sampling::UniformCone::mean_clamped_cosine`], through [`ConeShading`], also
+    /// ([`crate::sampling::UniformCone::mean_clamped_cosine`], through [`LightShading`], also
     /// where the horizon cuts the cone),
     /// less what the cone point `w_s` (uniform in the cone) finds blocked, `c_s = max(0, n .
     /// w_s)`. Since `E[c_s] = mean_cone(max(0, n . w))` this is a control variate: its
