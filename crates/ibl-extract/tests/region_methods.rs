@@ -13,7 +13,7 @@ use ibl_core::{Image, LatLong, Rgb, fibonacci_normals, irradiance_exact};
 use ibl_extract::{
     ExtractError, LightGenOptions, adaptive_median_cut, lightgen, median_cut, variance_minimization,
 };
-use ibl_light::LightSet;
+use ibl_light::{Light, LightSet};
 
 /// The bundled probes, read once.
 fn bundled_probes() -> &'static [(String, Image<Rgb>)] {
@@ -221,6 +221,14 @@ fn sun_in_sky_probe(sky: f32) -> (Image<Rgb>, f64, DVec3) {
     (img, sun_sr, ll.pixel_dir64(sx, sy))
 }
 
+/// The light of most green power: the sun's.
+fn brightest(set: &LightSet) -> &Light {
+    set.lights
+        .iter()
+        .max_by(|a, b| a.irradiance[1].total_cmp(&b.irradiance[1]))
+        .expect("a light")
+}
+
 #[test]
 fn a_sun_in_a_region_of_sky_spreads_over_the_sun_not_the_region() {
     // The sun carries 88 % of the probe's power: whatever region or cluster holds it, its light's
@@ -234,11 +242,7 @@ fn a_sun_in_a_region_of_sky_spreads_over_the_sun_not_the_region() {
     for method in METHODS {
         for n in [1usize, 4, 16] {
             let set = run(method, &img, n).unwrap();
-            let sun = set
-                .lights
-                .iter()
-                .max_by(|a, b| a.irradiance[1].total_cmp(&b.irradiance[1]))
-                .unwrap();
+            let sun = brightest(&set);
             assert!(sun.direction.dot(d) > 0.999, "{method} N={n}");
             let spread = sun.spread_sr.expect("region methods measure the spread");
             assert!(
@@ -278,11 +282,7 @@ fn a_sun_in_a_region_of_sky_keeps_the_sky_out_of_its_core() {
     for method in METHODS {
         for n in [1usize, 4, 16] {
             let set = run(method, &img, n).unwrap();
-            let sun = set
-                .lights
-                .iter()
-                .max_by(|a, b| a.irradiance[1].total_cmp(&b.irradiance[1]))
-                .unwrap();
+            let sun = brightest(&set);
             let share = 5e4 * sun_sr / sun.irradiance[1];
             let core = sun.core_fraction.expect("measured with the spread");
             if share <= 1.0 {
