@@ -54,6 +54,7 @@
 
 use glam::DVec3;
 use ibl_core::{Image, Rgb};
+use ibl_light::spread::WIDEST_CORE_IN_A_CLUSTER;
 use ibl_light::{Extraction, Light, LightSet, Provenance, SpreadHistogram};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
@@ -228,7 +229,7 @@ pub fn lightgen(
     }
     for ((_, l), h) in lights.iter_mut().zip(&spreads) {
         l.spread_sr = h.spread_sr();
-        l.core_fraction = core_fraction(h, l);
+        l.core_fraction = core_fraction(h, l, WIDEST_CORE_IN_A_CLUSTER);
     }
     lights.sort_by(|a, b| b.0.total_cmp(&a.0));
     Ok(LightSet {

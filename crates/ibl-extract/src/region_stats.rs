@@ -50,6 +50,7 @@ use rayon::prelude::*;
 
 use crate::ExtractError;
 use ibl_core::rgb::Rgb64;
+use ibl_light::spread::WIDEST_CORE_IN_A_REGION;
 use ibl_light::{Light, PixelRegion, SpreadHistogram};
 
 /// Rec. 709 luminance weights in f64 (the same numbers as `ibl_core::rgb::LUMINANCE_WEIGHTS`).
@@ -579,16 +580,22 @@ fn region_light<const SUM_MOMENT: bool>(
         .unwrap_or(DVec3::Y);
     let histogram = region_spread(probe, grid, &r, dir);
     let mut l = light(dir, power, solid_angle, histogram.spread_sr(), Some(r));
-    l.core_fraction = core_fraction(&histogram, &l);
+    l.core_fraction = core_fraction(&histogram, &l, WIDEST_CORE_IN_A_REGION);
     l
 }
 
-/// A light's [`Light::core_fraction`] from the histogram of its pixels: `None` where it has no
-/// spread.
-pub(crate) fn core_fraction(histogram: &SpreadHistogram, light: &Light) -> Option<f64> {
+/// A light's [`Light::core_fraction`] from the histogram of its pixels, a halo only for cores
+/// of at most `widest_core` of its source ([`SpreadHistogram::core_fraction`]): `None` where it
+/// has no spread.
+pub(crate) fn core_fraction(
+    histogram: &SpreadHistogram,
+    light: &Light,
+    widest_core: f64,
+) -> Option<f64> {
+    let core_sr = light.shadow_solid_angle_sr();
     light
         .spread_sr
-        .map(|_| histogram.core_fraction(light.shadow_solid_angle_sr(), light.solid_angle_sr))
+        .map(|_| histogram.core_fraction(core_sr, light.solid_angle_sr, widest_core))
 }
 
 /// Rows per chunk of [`region_spread`]'s parallel histograms.

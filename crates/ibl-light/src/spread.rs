@@ -37,13 +37,18 @@
 //! with `f` from 0.7 to 1 that light's bunny-sky error was least at 0.92 to 0.95 (BENCHMARKS.md,
 //! "A core and a halo").
 //!
-//! Only a core of at most half its source's solid angle ([`MAX_CORE`]) gets a halo. Wider, the
-//! two cones are nearly one shape and `f` is ill-conditioned (on the bundled apartment probe
-//! variance minimisation's regions with a core of 0.7 to 0.9 of the source fitted `f` from 0 to
-//! 0.7), and the halo, a uniform cone about the light, stands for a region whose own shape (a
-//! rectangle of lat-long, often long and thin) matters more: with every core given a halo, 16
-//! variance-minimisation lights on bunny-apartment scored 13.1x the reference's noise floor
-//! against 9.6x without halos, and 9.9x with this bound.
+//! Only a core narrow enough beside its source gets a halo: at most half the source's solid
+//! angle for a region of the lat-long image ([`WIDEST_CORE_IN_A_REGION`]), nine tenths for a
+//! LightGen cluster ([`WIDEST_CORE_IN_A_CLUSTER`]). The halo is a uniform cone about the light.
+//! A lat-long rectangle (median cut's, variance minimisation's) is often long and thin, and a
+//! cone of its solid angle blurs its shadow the wrong way: with a halo for every core below 0.9
+//! of the region, 16 variance-minimisation lights on bunny-apartment scored 13.1x the
+//! reference's noise floor against 9.6x without halos (9.9x with the bound of one half; their
+//! regions with cores of 0.7 to 0.9 of the source fitted `f` anywhere from 0 to 0.7). A
+//! LightGen cluster is the set of pixels nearest a direction, a compact cell of the sphere,
+//! which a cone stands for: its 16 lights on bunny-apartment scored 6.9x with the bound of one
+//! half and 4.5x with nine tenths (bunny-sky: 5.1x with either). Above nine tenths the two
+//! cones are nearly one shape and `f` loses its meaning (`a - b -> 0`).
 //!
 //! The half-energy angle is found in a histogram of `1 - cos` over [`BINS`] bins, eight per
 //! octave from `2^-32` to 2 (bins read off the f64 bit pattern: no logarithm per pixel), with
@@ -61,9 +66,14 @@ pub const BINS: usize = (PER_OCTAVE * OCTAVES) as usize;
 /// Biased exponent of `2^-32`, the first bin's lower bound.
 const FIRST_EXPONENT: u64 = 1023 - 32;
 
-/// The widest core, as a fraction of the halo's solid angle, that gets a halo: wider cores keep
-/// all the power (module doc, "A core and a halo").
-pub const MAX_CORE: f64 = 0.5;
+/// The widest core, as a fraction of its source's solid angle, that gets a halo when the source
+/// is a region of the lat-long image (median cut, adaptive median cut, variance minimisation):
+/// wider cores keep all the power (module doc, "A core and a halo").
+pub const WIDEST_CORE_IN_A_REGION: f64 = 0.5;
+
+/// The same for a LightGen cluster: the pixels nearest a direction, a compact cell of the sphere
+/// that a cone stands for better than for a lat-long rectangle (module doc).
+pub const WIDEST_CORE_IN_A_CLUSTER: f64 = 0.9;
 
 /// A histogram of a light's energy over `1 - cos` of the angle to its direction, with the
 /// energy and the pixels' extent it needs for [`SpreadHistogram::spread_sr`].
@@ -179,12 +189,14 @@ impl SpreadHistogram {
 impl SpreadHistogram {
     /// The fraction `f` of the power in the core of `core_sr` (sr) when the rest spreads as a
     /// uniform halo of `source_sr` (sr), fitted to the histogram (module doc), in `[0, 1]`. 1
-    /// when the core is wider than [`MAX_CORE`] of the halo, when no energy was added, or when
-    /// the inputs are not finite and positive. O([`BINS`]).
-    pub fn core_fraction(&self, core_sr: f64, source_sr: f64) -> f64 {
+    /// when the core's `1 - cos` is more than `widest_core` (below 1:
+    /// [`WIDEST_CORE_IN_A_REGION`], [`WIDEST_CORE_IN_A_CLUSTER`]) of the halo's, when no energy
+    /// was added, or when the inputs are not finite and positive. O([`BINS`]).
+    pub fn core_fraction(&self, core_sr: f64, source_sr: f64, widest_core: f64) -> f64 {
         let tau = 2.0 * std::f64::consts::PI;
         let (xc, xa) = (core_sr / tau, (source_sr / tau).min(2.0));
-        if !(self.energy > 0.0 && self.energy.is_finite() && xc > 0.0 && xc <= MAX_CORE * xa) {
+        let narrow = xc > 0.0 && xc <= widest_core.min(0.9) * xa;
+        if !(self.energy > 0.0 && self.energy.is_finite() && narrow) {
             return 1.0;
         }
         // The integrals over x in [0, x_A], by the trapezoid rule over the bins' edges (and
@@ -220,7 +232,7 @@ impl SpreadHistogram {
             }
             below += e;
         }
-        // `den >= x_A / 12` for a core of at most half the halo: never 0.
+        // `den >= x_A / 300` for a core of at most 0.9 of the halo: never 0.
         if den > 0.0 {
             (num / den).clamp(0.0, 1.0)
         } else {
@@ -306,7 +318,7 @@ mod tests {
                 );
             }
             let core = h.spread_sr().unwrap();
-            let f = h.core_fraction(core, TAU * sky);
+            let f = h.core_fraction(core, TAU * sky, WIDEST_CORE_IN_A_REGION);
             // The sky inside the sun's cone counts as core: `share + (1 - share) sun / sky`,
             // within the trapezoid rule's error over the bins (3e-3).
             let expected = share + (1.0 - share) * sun / sky;
@@ -317,11 +329,16 @@ mod tests {
             uniform.add(sky * (k as f64 + 0.5) / 10_000.0, 1.0, 0.0);
         }
         let core = uniform.spread_sr().unwrap();
-        let f = uniform.core_fraction(core, TAU * sky);
-        assert!(f > 0.99, "{f}");
-        assert_eq!(uniform.core_fraction(TAU * sky, TAU * sky), 1.0);
-        assert_eq!(SpreadHistogram::new().core_fraction(0.1, 1.0), 1.0);
-        assert_eq!(uniform.core_fraction(f64::NAN, 1.0), 1.0);
+        for widest in [WIDEST_CORE_IN_A_REGION, WIDEST_CORE_IN_A_CLUSTER] {
+            let f = uniform.core_fraction(core, TAU * sky, widest);
+            assert!(f > 0.99, "{f}");
+            // A core half the cone: the uniform cone is all halo.
+            let f = uniform.core_fraction(0.5 * TAU * sky, TAU * sky, widest);
+            assert!(f < 0.01, "{f}");
+        }
+        assert_eq!(uniform.core_fraction(TAU * sky, TAU * sky, 0.9), 1.0);
+        assert_eq!(SpreadHistogram::new().core_fraction(0.1, 1.0, 0.5), 1.0);
+        assert_eq!(uniform.core_fraction(f64::NAN, 1.0, 0.5), 1.0);
     }
 
     #[test]
