@@ -561,8 +561,9 @@ impl<'a> Tracer<'a> {
     /// (1 - V(w_s)))`: its unshadowed light exact
     /// ([`crate::sampling::UniformCone::mean_clamped_cosine`], through [`LightShading`], also
     /// where the horizon cuts the cone),
-    /// less what the cone point `w_s` (uniform in the cone) finds blocked, `c_s = max(0, n .
-    /// w_s)`. Since `E[c_s] = mean_cone(max(0, n . w))` this is a control variate: its
+    /// less what the cone point `w_s` (uniform in the cone; for a light with a halo, in the
+    /// halo with the halo's share and in the core otherwise, with `mean_cone` their
+    /// share-weighted mean) finds blocked, `c_s = max(0, n . w_s)`. Since `E[c_s] = mean_cone(max(0, n . w))` this is a control variate: its
     /// expectation is the cone's shadowed light `f L int_cone max(0, n . w) V(w) dw` (for a
     /// diffuse surface exactly; a glossy lobe is read at the axis, [`cone_bsdf`]), the same as
     /// `f I c_s V(w_s)` per point, but where the ray is open it is the exact unshadowed value,
