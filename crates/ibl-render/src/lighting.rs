@@ -72,20 +72,6 @@ pub struct DirectionalLight {
 }
 
 impl DirectionalLight {
-    /// A point of the light's soft shadow, uniform in its core (`cone`) with probability `1 -
-    /// s` and in its halo with `s`, from `u1, u2` in `[0, 1)` (`u1` picks the cone and is
-    /// rescaled, so stratified points stay stratified); world frame. `None` without a cone.
-    pub fn shadow_point(&self, u1: f32, u2: f32) -> Option<Vec3> {
-        let core = self.cone?;
-        let below_one = |u: f32| u.clamp(0.0, 1.0 - f32::EPSILON / 2.0);
-        let local = match self.halo {
-            Some((halo, share)) if u1 < share => halo.sample(below_one(u1 / share), u2),
-            Some((_, share)) => core.sample(below_one((u1 - share) / (1.0 - share)), u2),
-            None => core.sample(u1, u2),
-        };
-        Some(self.frame.to_world(local))
-    }
-
     /// The mean clamped cosine of the light's cones (shares as weights) to a normal at
     /// `cos_beta` from its direction ([`UniformCone::mean_clamped_cosine`]); `cos_beta`
     /// clamped at 0 without a cone.

@@ -561,9 +561,9 @@ impl<'a> Tracer<'a> {
     /// (1 - V(w_s)))`: its unshadowed light exact
     /// ([`crate::sampling::UniformCone::mean_clamped_cosine`], through [`LightShading`], also
     /// where the horizon cuts the cone),
-    /// less what the cone point `w_s` (uniform in the cone; for a light with a halo, in the
-    /// halo with the halo's share and in the core otherwise, with `mean_cone` their
-    /// share-weighted mean) finds blocked, `c_s = max(0, n . w_s)`. Since `E[c_s] = mean_cone(max(0, n . w))` this is a control variate: its
+    /// less what the cone point `w_s` (uniform in the cone) finds blocked, `c_s = max(0, n .
+    /// w_s)` (a light with a halo: `mean_cone` is its two cones' share-weighted mean, and one
+    /// point in each cone takes off its share). Since `E[c_s] = mean_cone(max(0, n . w))` this is a control variate: its
     /// expectation is the cone's shadowed light `f L int_cone max(0, n . w) V(w) dw` (for a
     /// diffuse surface exactly; a glossy lobe is read at the axis, [`cone_bsdf`]), the same as
     /// `f I c_s V(w_s)` per point, but where the ray is open it is the exact unshadowed value,
@@ -585,7 +585,7 @@ impl<'a> Tracer<'a> {
         let surface = vertex.surface;
         for (index, light) in list.lights.iter().enumerate() {
             match (list.shadows, light.cone) {
-                (ShadowKind::Soft, Some(_)) => {
+                (ShadowKind::Soft, Some(core)) => {
                     let axis = light.direction;
                     let cos_beta = surface.shading_normal.dot(axis);
                     let mean_cos = match &self.cone_shading.get(index) {
@@ -593,12 +593,15 @@ impl<'a> Tracer<'a> {
                         _ => light.mean_clamped_cosine(cos_beta),
                     };
                     let f = cone_bsdf(vertex, axis, cos_beta);
+                    // A light with a halo draws a cone point in each of its two cones.
+                    let points = if light.halo.is_some() { 2 } else { 1 };
                     if mean_cos <= 0.0 || f.max_channel() <= 0.0 {
-                        stream.skip_2d();
+                        (0..points).for_each(|_| stream.skip_2d());
                         continue;
                     }
                     let light_value = f * light.irradiance;
-                    if let Some(occlusion) = state.known.occlusion(index) {
+                    let halo = light.halo;
+                    if let (None, Some(occlusion)) = (halo, state.known.occlusion(index)) {
                         // Known from the neighbourhood for the whole cone: its exact light where
                         // it is open, nothing where it is blocked; no cone point is needed.
                         stream.skip_2d();
@@ -607,25 +610,36 @@ impl<'a> Tracer<'a> {
                         continue;
                     }
                     // The unshadowed cone, exact, in every layer; then what the cone point's
-                    // ray finds blocked is taken off where it is blocked.
+                    // ray finds blocked is taken off where it is blocked. A light with a halo
+                    // sends one ray into each cone, each taking off its cone's share (two rays,
+                    // not one into a cone chosen by its share: a halo holding 4 % of a sun
+                    // would otherwise take off the whole sun 4 % of the time, speckles at 4
+                    // samples a pixel), and is never lent by the neighbourhood, whose two rays
+                    // may disagree.
                     sum.add_all(light_value * mean_cos);
-                    let [u1, u2] = stream.next_2d();
-                    let Some(point) = light.shadow_point(u1, u2) else {
-                        continue;
-                    };
-                    let cos = surface.shading_normal.dot(point);
-                    if cos <= 0.0 {
-                        // Below the shading surface the cone adds nothing: nothing to take off.
-                        continue;
+                    let core_share = halo.map_or(1.0, |(_, share)| 1.0 - share);
+                    let cones = std::iter::once((core, core_share)).chain(halo);
+                    for (cone, share) in cones {
+                        let [u1, u2] = stream.next_2d();
+                        let point = light.frame.to_world(cone.sample(u1, u2));
+                        let cos = surface.shading_normal.dot(point);
+                        if cos <= 0.0 {
+                            // Below the shading surface the cone adds nothing: nothing to take
+                            // off.
+                            continue;
+                        }
+                        let occlusion = if surface.geometric_normal.dot(point) <= 0.0 {
+                            // Above the shading surface but below the geometric one: the
+                            // surface itself hides it (as in `Vertex::reflection`), in every
+                            // layer.
+                            Occlusion::Real
+                        } else if halo.is_some() {
+                            self.traced_light_occlusion(origin, point, index, state)
+                        } else {
+                            self.light_occlusion(origin, point, index, state)
+                        };
+                        sum.add_blocked(occlusion, light_value * (share * -cos));
                     }
-                    let occlusion = if surface.geometric_normal.dot(point) <= 0.0 {
-                        // Above the shading surface but below the geometric one: the surface
-                        // itself hides it (as in `Vertex::reflection`), in every layer.
-                        Occlusion::Real
-                    } else {
-                        self.light_occlusion(origin, point, index, state)
-                    };
-                    sum.add_blocked(occlusion, light_value * -cos);
                 }
                 _ => {
                     let wi = light.direction;
@@ -756,10 +770,23 @@ impl<'a> Tracer<'a> {
         if let Some(occlusion) = state.known.occlusion(index) {
             return self.known_occlusion(index, occlusion, state);
         }
+        let occlusion = self.traced_light_occlusion(origin, wi, index, state);
+        state.seen.record(index, occlusion);
+        occlusion
+    }
+
+    /// What blocks light `index`'s shadow ray from `origin` along `wi`, traced (with the light's
+    /// shadow-cache hints), neither lent by the neighbourhood nor recorded for it.
+    fn traced_light_occlusion(
+        &self,
+        origin: Vec3,
+        wi: Vec3,
+        index: usize,
+        state: &mut PathState,
+    ) -> Occlusion {
         let mut hints = *state.hints.light(index);
         let occlusion = self.blocked(origin, wi, f32::INFINITY, &mut hints, state);
         *state.hints.light(index) = hints;
-        state.seen.record(index, occlusion);
         occlusion
     }
 

@@ -991,23 +991,6 @@ fn a_light_with_a_core_fraction_shadows_as_a_core_and_a_halo() {
     let (halo, share) = light.halo.expect("a halo");
     assert!((core.solid_angle() - 0.01).abs() < 1e-7);
     assert!((halo.solid_angle() - 0.5).abs() < 1e-6 && (share - 0.25).abs() < 1e-7);
-    // Its shadow points: a quarter of a stratified set falls outside the core (the halo's
-    // points inside the core's cone, 0.01 / 0.5 of them, count as inside), each point unit.
-    let cos_core = 1.0 - 0.01 / std::f32::consts::TAU;
-    let n = 4000;
-    let outside = (0..n)
-        .filter(|&k| {
-            let u1 = (k as f32 + 0.5) / n as f32;
-            let p = light.shadow_point(u1, 0.37).expect("a point");
-            assert!((p.length() - 1.0).abs() < 1e-5);
-            p.y < cos_core
-        })
-        .count();
-    let expected = 0.25 * (1.0 - 0.01 / 0.5) * n as f32;
-    assert!(
-        (outside as f32 - expected).abs() <= 2.0,
-        "{outside} {expected}"
-    );
     // Its unshadowed cosine is the two cones' means weighted by their shares.
     for cos_beta in [1.0f32, 0.5, 0.1, -0.05, -0.5] {
         let want =
@@ -1019,4 +1002,57 @@ fn a_light_with_a_core_fraction_shadows_as_a_core_and_a_halo() {
     let list =
         ibl_render::lighting::LightList::from_set(&set, glam::DMat3::IDENTITY, ShadowKind::Soft);
     assert_eq!(list.lights[0].halo, None);
+}
+
+#[test]
+fn a_halo_light_renders_as_its_two_cones_as_two_lights() {
+    // A light of 0.5 sr whose core of 0.01 sr holds 80 % of its power shadows as two lights in
+    // its direction would, 80 % of the power in a cone of 0.01 sr and 20 % in one of 0.5 sr:
+    // the same estimate, traced by one renderer light with two rays a sample (the halo) or by
+    // two lights with one each, from the same Sobol pairs in the same order. Over the floating
+    // sphere's shadow, 64 samples a pixel: equal but for the order of f32 sums (measured: shadow
+    // integrals within 5e-9 of each other, images within a relative MSE of 1.4e-16; bounds 1e-6
+    // and 1e-10).
+    let d = light_direction();
+    let scene = shadow_scene(true);
+    let mut halo = one_light(d, IRRADIANCE, 0.5);
+    halo.lights[0].spread_sr = Some(0.01);
+    halo.lights[0].core_fraction = Some(0.8);
+    let mut two = one_light(d, IRRADIANCE.map(|c| 0.8 * c), 0.01);
+    two.lights
+        .extend(one_light(d, IRRADIANCE.map(|c| 0.2 * c), 0.5).lights);
+    let mut integrals = Vec::new();
+    let mut images = Vec::new();
+    for set in [&halo, &two] {
+        let lighting = Lighting::lights(&scene, set, ShadowKind::Soft).unwrap();
+        let out = run(
+            &scene,
+            &lighting,
+            &settings(64, 1, 4, CompositeRule::Difference),
+        );
+        let blocked: f64 = out
+            .with_objects
+            .pixels()
+            .iter()
+            .zip(out.without_objects.pixels())
+            .map(|(w, wo)| f64::from(wo.g - w.g))
+            .sum();
+        integrals.push(blocked);
+        images.push(out.with_objects);
+    }
+    let relative_mse = images[0]
+        .pixels()
+        .iter()
+        .zip(images[1].pixels())
+        .map(|(a, b)| {
+            let (a, b) = (f64::from(a.g), f64::from(b.g));
+            (a - b) * (a - b) / (b * b + 0.01)
+        })
+        .sum::<f64>()
+        / images[0].pixels().len() as f64;
+    assert!(
+        (integrals[0] / integrals[1] - 1.0).abs() < 1e-6,
+        "{integrals:?}"
+    );
+    assert!(relative_mse < 1e-10, "{relative_mse}");
 }
