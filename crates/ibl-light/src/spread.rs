@@ -47,8 +47,10 @@
 //! regions with cores of 0.7 to 0.9 of the source fitted `f` anywhere from 0 to 0.7). A
 //! LightGen cluster is the set of pixels nearest a direction, a compact cell of the sphere,
 //! which a cone stands for: its 16 lights on bunny-apartment scored 6.9x with the bound of one
-//! half and 4.5x with nine tenths (bunny-sky: 5.1x with either). Above nine tenths the two
-//! cones are nearly one shape and `f` loses its meaning (`a - b -> 0`).
+//! half and 4.5x with nine tenths (bunny-sky: 5.1x with either). (These were measured while a
+//! halo light sent one shadow ray a sample; BENCHMARKS.md, "A core and a halo", has the
+//! figures with one ray into each cone.) Above nine tenths the two cones are nearly one shape
+//! and `f` loses its meaning (`a - b -> 0`).
 //!
 //! The half-energy angle is found in a histogram of `1 - cos` over [`BINS`] bins, eight per
 //! octave from `2^-32` to 2 (bins read off the f64 bit pattern: no logarithm per pixel), with
