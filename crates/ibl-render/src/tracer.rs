@@ -601,10 +601,15 @@ impl<'a> Tracer<'a> {
                     }
                     let light_value = f * light.irradiance;
                     let halo = light.halo;
-                    if let (None, Some(occlusion)) = (halo, state.known.occlusion(index)) {
+                    let known = state.known.occlusion(index);
+                    if let Some(occlusion) =
+                        known.filter(|&o| halo.is_none() || o == Occlusion::Open)
+                    {
                         // Known from the neighbourhood for the whole cone: its exact light where
-                        // it is open, nothing where it is blocked; no cone point is needed.
-                        stream.skip_2d();
+                        // it is open, nothing where it is blocked; no cone point is needed. A
+                        // light with a halo is lent only "open": its record says open only where
+                        // both its rays were.
+                        (0..points).for_each(|_| stream.skip_2d());
                         let occlusion = self.known_occlusion(index, occlusion, state);
                         sum.add(occlusion, light_value * mean_cos);
                         continue;
@@ -614,11 +619,12 @@ impl<'a> Tracer<'a> {
                     // sends one ray into each cone, each taking off its cone's share (two rays,
                     // not one into a cone chosen by its share: a halo holding 4 % of a sun
                     // would otherwise take off the whole sun 4 % of the time, speckles at 4
-                    // samples a pixel), and is never lent by the neighbourhood, whose two rays
-                    // may disagree.
+                    // samples a pixel); its record for the neighbourhood is "open" where both
+                    // rays were, else the first blocked one's answer.
                     sum.add_all(light_value * mean_cos);
                     let core_share = halo.map_or(1.0, |(_, share)| 1.0 - share);
                     let cones = std::iter::once((core, core_share)).chain(halo);
+                    let mut record = None;
                     for (cone, share) in cones {
                         let [u1, u2] = stream.next_2d();
                         let point = light.frame.to_world(cone.sample(u1, u2));
@@ -634,11 +640,19 @@ impl<'a> Tracer<'a> {
                             // layer.
                             Occlusion::Real
                         } else if halo.is_some() {
-                            self.traced_light_occlusion(origin, point, index, state)
+                            let occlusion =
+                                self.traced_light_occlusion(origin, point, index, state);
+                            if record.is_none() || record == Some(Occlusion::Open) {
+                                record = Some(occlusion);
+                            }
+                            occlusion
                         } else {
                             self.light_occlusion(origin, point, index, state)
                         };
                         sum.add_blocked(occlusion, light_value * (share * -cos));
+                    }
+                    if let Some(occlusion) = record {
+                        state.seen.record(index, occlusion);
                     }
                 }
                 _ => {
