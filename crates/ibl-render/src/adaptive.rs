@@ -75,26 +75,33 @@ pub fn needs_refinement(
     y: usize,
     contrast: f32,
 ) -> Option<KnownVisibility> {
+    let neighbourhood = || {
+        (y.saturating_sub(1)..(y + 2).min(height))
+            .flat_map(move |ny| (x.saturating_sub(1)..(x + 2).min(width)).map(move |nx| (nx, ny)))
+    };
     let centre = first[y * width + x];
-    let mut agreement = Agreement::new(centre);
     let (mut with, mut without, mut others) = (Rgb::ZERO, Rgb::ZERO, 0u32);
-    for ny in y.saturating_sub(1)..(y + 2).min(height) {
-        for nx in x.saturating_sub(1)..(x + 2).min(width) {
-            let s = first[ny * width + nx];
-            agreement.add(s);
-            if (nx, ny) != (x, y) {
-                with += s.with;
-                without += s.without;
-                others += 1;
-            }
+    let mut silhouette = false;
+    for (nx, ny) in neighbourhood() {
+        let s = &first[ny * width + nx];
+        silhouette |= s.primary != centre.primary;
+        if (nx, ny) != (x, y) {
+            with += s.with;
+            without += s.without;
+            others += 1;
         }
     }
     let n = others.max(1) as f32;
-    if !agreement.silhouette
+    if !silhouette
         && !deviates(centre.with, with / n, contrast)
         && !deviates(centre.without, without / n, contrast)
     {
         return None;
+    }
+    // Only a pixel that is refined needs what its neighbours agree on.
+    let mut agreement = Agreement::EMPTY;
+    for (nx, ny) in neighbourhood() {
+        agreement.add(first[ny * width + nx]);
     }
     Some(agreement.known())
 }
@@ -149,7 +156,7 @@ impl CoarseGrid {
             y.saturating_sub(REACH).div_ceil(2),
             ((y + REACH) / 2).min(self.height - 1),
         );
-        let mut agreement = Agreement::new(coarse[j0 * self.width + i0]);
+        let mut agreement = Agreement::EMPTY;
         for j in j0..=j1 {
             for i in i0..=i1 {
                 agreement.add(coarse[j * self.width + i]);
@@ -162,11 +169,9 @@ impl CoarseGrid {
 /// How far, in image pixels, [`CoarseGrid::known`] looks for coarse pixels.
 const REACH: usize = 3;
 
-/// What a set of first samples agree on: one kind of primary hit or not, and per kind of surface, per light, whether each sample of that kind traced it and
-/// found it blocked the same way.
+/// What a set of first samples agree on: per kind of surface, per light, whether each sample
+/// of that kind traced it and found it blocked the same way.
 struct Agreement {
-    primary: PrimaryHit,
-    silhouette: bool,
     /// Real surfaces, virtual objects.
     kinds: [KindAgreement; 2],
 }
@@ -174,9 +179,10 @@ struct Agreement {
 /// The agreement of the samples of one kind of surface.
 #[derive(Clone, Copy)]
 struct KindAgreement {
-    samples: u32,
-    /// Per light, how many samples traced it (a cone point below the surface traces none).
-    tested: [u8; 64],
+    /// Per light, how many samples traced it (a cone point below the surface traces none), as
+    /// a bit-sliced counter: bit `i` of plane `k` is bit `k` of light `i`'s count (up to 31; a
+    /// neighbourhood holds at most 16 samples). All 64 lights count in a few word operations.
+    tested: [u64; 5],
     /// Blocked by the real layer in every sample that traced it, in some sample.
     all_real: u64,
     any_real: u64,
@@ -187,13 +193,12 @@ struct KindAgreement {
 
 /// Fewest samples that must have traced a light, all alike, before their answer is lent: a soft
 /// shadow's random first samples rarely agree by chance across this many (a cone half hidden,
-/// one time in 2^(n-1)).
+/// one time in 2^(n-1)). [`KindAgreement::known`] reads `count >= 6` off the counter's planes.
 const MIN_AGREEING: u8 = 6;
 
 impl KindAgreement {
     const EMPTY: KindAgreement = KindAgreement {
-        samples: 0,
-        tested: [0; 64],
+        tested: [0; 5],
         all_real: u64::MAX,
         any_real: 0,
         all_virtual: u64::MAX,
@@ -201,11 +206,12 @@ impl KindAgreement {
     };
 
     fn add(&mut self, v: LightVisibility) {
-        self.samples += 1;
-        let mut bits = v.tested;
-        while bits != 0 {
-            self.tested[bits.trailing_zeros() as usize] += 1;
-            bits &= bits - 1;
+        // One added to the count of every light in `v.tested`: a ripple-carry add per plane.
+        let mut carry = v.tested;
+        for plane in &mut self.tested {
+            let next = *plane & carry;
+            *plane ^= carry;
+            carry = next;
         }
         // A sample that did not trace a light says nothing about it: neutral in the "every".
         self.all_real &= v.real | !v.tested;
@@ -217,12 +223,10 @@ impl KindAgreement {
     /// The lights that at least [`MIN_AGREEING`] samples traced, every one of them finding it
     /// blocked alike, with those answers.
     fn known(&self) -> LightVisibility {
-        let enough = self
-            .tested
-            .iter()
-            .enumerate()
-            .filter(|(_, n)| **n >= MIN_AGREEING)
-            .fold(0u64, |mask, (i, _)| mask | 1 << i);
+        const { assert!(MIN_AGREEING == 6) };
+        // count >= 6: 8 or more (plane 3 or 4), or 6 and 7 (planes 1 and 2).
+        let [_, p1, p2, p3, p4] = self.tested;
+        let enough = p4 | p3 | (p2 & p1);
         let uniform =
             enough & !(self.all_real ^ self.any_real) & !(self.all_virtual ^ self.any_virtual);
         LightVisibility {
@@ -234,16 +238,11 @@ impl KindAgreement {
 }
 
 impl Agreement {
-    fn new(first: FirstSample) -> Agreement {
-        Agreement {
-            primary: first.primary,
-            silhouette: false,
-            kinds: [KindAgreement::EMPTY; 2],
-        }
-    }
+    const EMPTY: Agreement = Agreement {
+        kinds: [KindAgreement::EMPTY; 2],
+    };
 
     fn add(&mut self, s: FirstSample) {
-        self.silhouette |= s.primary != self.primary;
         match s.primary {
             PrimaryHit::Real => self.kinds[0].add(s.visibility),
             PrimaryHit::Virtual => self.kinds[1].add(s.visibility),
@@ -263,6 +262,62 @@ impl Agreement {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_bit_sliced_counts_agree_with_counting_each_light() {
+        // Up to 16 samples (the coarse grid's 4 x 4), random lights traced and blocked.
+        let mut state = 0x1234_5678_9abc_def0u64;
+        let mut next = || {
+            state = crate::sampling::splitmix64(state);
+            state
+        };
+        for samples in 0..=16 {
+            for _ in 0..50 {
+                // Lights in `shared` are blocked alike in every sample that traces them.
+                let (shared, real_shared, virtual_shared) = (next() | next(), next(), next());
+                let visibilities: Vec<LightVisibility> = (0..samples)
+                    .map(|_| {
+                        let tested = next() | next();
+                        let real = ((real_shared & shared) | (next() & !shared)) & tested;
+                        let virtual_only =
+                            ((virtual_shared & shared) | (next() & !shared)) & tested & !real;
+                        LightVisibility {
+                            tested,
+                            real,
+                            virtual_only,
+                        }
+                    })
+                    .collect();
+                let mut agreement = KindAgreement::EMPTY;
+                visibilities.iter().for_each(|&v| agreement.add(v));
+                let known = agreement.known();
+                for light in 0..64 {
+                    let bit = 1u64 << light;
+                    let traced: Vec<_> = visibilities
+                        .iter()
+                        .filter(|v| v.tested & bit != 0)
+                        .collect();
+                    let alike = |f: fn(&LightVisibility) -> u64| {
+                        traced.iter().all(|v| f(v) & bit != 0)
+                            || traced.iter().all(|v| f(v) & bit == 0)
+                    };
+                    let lent = traced.len() >= usize::from(MIN_AGREEING)
+                        && alike(|v| v.real)
+                        && alike(|v| v.virtual_only);
+                    assert_eq!(
+                        known.tested & bit != 0,
+                        lent,
+                        "{samples} samples, light {light}"
+                    );
+                    if lent {
+                        assert_eq!(known.real & bit != 0, traced[0].real & bit != 0);
+                        let virtual_only = traced[0].virtual_only & bit != 0;
+                        assert_eq!(known.virtual_only & bit != 0, virtual_only);
+                    }
+                }
+            }
+        }
+    }
 
     fn sample(primary: PrimaryHit, v: f32) -> FirstSample {
         FirstSample {

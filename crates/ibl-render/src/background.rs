@@ -25,14 +25,14 @@ pub fn background_image(scene: &Scene, width: u32, height: u32) -> Image<Rgb> {
     let probe = &scene.probe.radiance;
     match &scene.background {
         Background::Panorama if matches!(scene.camera, Camera::Pinhole { .. }) => {
-            let footprint = PixelFootprint::new(
+            PixelFootprint::new(
                 probe,
                 &scene.camera,
                 scene.probe.world_from_probe,
                 width,
                 height,
-            );
-            Image::from_fn_par(w, h, |x, y| footprint.mean(x as u32, y as u32))
+            )
+            .image()
         }
         Background::Panorama if probe.width() == w && probe.height() == h => probe.clone(),
         Background::Panorama => area_resize(probe, w, h),

@@ -27,11 +27,14 @@
 //! radiance at its centre ray.
 //!
 //! Cost: O(texels covered) clips per pixel; one pixel covers a few texels at the example scenes'
-//! sizes.
+//! sizes, and a pixel provably inside one texel takes it without clipping
+//! (`PixelFootprint::parallels_bulge`). Each pixel corner's ray is computed once for the four
+//! pixels that share it ([`PixelFootprint::image`]).
 
 use glam::{DVec3, Mat3, Vec3};
 use ibl_core::{Image, LatLong, Rgb};
 use ibl_scene::Camera;
+use rayon::prelude::*;
 
 /// Largest number of splits of a pixel around a pole (a pixel becomes at most `4^MAX_DEPTH`
 /// cells there).
@@ -45,6 +48,27 @@ pub struct PixelFootprint<'a> {
     /// The camera's viewing direction, world frame (`d . forward = 1` is the image plane).
     forward: Vec3,
     size: (u32, u32),
+    /// [`PixelFootprint::parallel_cos`] of rows `0..=H`, computed once.
+    parallel_cos: Vec<f64>,
+    /// [`PixelFootprint::meridian_normal`] of columns `-W - 2 .. 2 W + 3` (every column a
+    /// footprint's unwrapped longitudes reach), computed once.
+    meridian_normals: Vec<DVec3>,
+}
+
+/// The corner of a pixel (or cell): its ray direction on the image plane and its texel
+/// coordinates.
+#[derive(Clone, Copy)]
+struct Corner {
+    direction: DVec3,
+    coords: (f64, f64),
+}
+
+/// Polygons a footprint's clipping reuses from pixel to pixel (no allocation per pixel).
+#[derive(Default)]
+struct Scratch {
+    row: Vec<DVec3>,
+    piece: Vec<DVec3>,
+    clipped: Vec<DVec3>,
 }
 
 impl<'a> PixelFootprint<'a> {
@@ -69,13 +93,42 @@ impl<'a> PixelFootprint<'a> {
                     .direction
             }
         };
+        let (w, h) = (probe.width() as i64, probe.height() as i64);
         PixelFootprint {
             probe,
             camera,
             probe_from_world: world_from_probe.transpose(),
             forward,
             size: (width, height),
+            parallel_cos: (0..=h).map(|j| parallel_cos(j, h)).collect(),
+            meridian_normals: (-w - 2..2 * w + 3).map(|i| meridian_normal(i, w)).collect(),
         }
+    }
+
+    /// The mean radiance over every pixel, row by row in parallel: each pixel corner's ray is
+    /// computed once (shared by four pixels), the clipping polygons reused along a row.
+    pub fn image(&self) -> Image<Rgb> {
+        let (w, h) = (self.size.0 as usize, self.size.1 as usize);
+        // Corners of row `y` of the grid of (w + 1) x (h + 1) pixel corners.
+        let corner_row = |y: usize| -> Vec<Corner> {
+            (0..=w).map(|x| self.corner(x as f64, y as f64)).collect()
+        };
+        let grid: Vec<Vec<Corner>> = (0..=h).into_par_iter().map(corner_row).collect();
+        let data: Vec<Rgb> = (0..h)
+            .into_par_iter()
+            .flat_map_iter(|y| {
+                let mut scratch = Scratch::default();
+                let (top, bottom) = (&grid[y], &grid[y + 1]);
+                (0..w)
+                    .map(|x| {
+                        let corners = [top[x], top[x + 1], bottom[x + 1], bottom[x]];
+                        let sum = self.cell_of(corners, x as f64, y as f64, 1.0, 0, &mut scratch);
+                        Rgb::new(sum[0] as f32, sum[1] as f32, sum[2] as f32)
+                    })
+                    .collect::<Vec<_>>()
+            })
+            .collect();
+        Image::from_vec(w, h, data).expect("one value per pixel")
     }
 
     /// The ray direction through continuous output pixel coordinates `(x, y)`, probe frame,
@@ -98,22 +151,39 @@ impl<'a> PixelFootprint<'a> {
         )
     }
 
-    /// The mean radiance over pixel `(x, y)`.
-    pub fn mean(&self, x: u32, y: u32) -> Rgb {
-        let sum = self.cell(f64::from(x), f64::from(y), 1.0, 0);
-        Rgb::new(sum[0] as f32, sum[1] as f32, sum[2] as f32)
+    /// A cell corner at continuous output pixel coordinates `(x, y)`.
+    fn corner(&self, x: f64, y: f64) -> Corner {
+        let direction = self.direction(x, y);
+        Corner {
+            direction,
+            coords: self.texel_coords(direction),
+        }
     }
 
     /// The mean over the square cell `[x, x + size) x [y, y + size)` (output pixel coordinates).
-    fn cell(&self, x: f64, y: f64, size: f64, depth: u32) -> [f64; 3] {
-        let (w, h) = (self.probe.width() as f64, self.probe.height() as f64);
+    fn cell(&self, x: f64, y: f64, size: f64, depth: u32, scratch: &mut Scratch) -> [f64; 3] {
         let corners = [
-            self.direction(x, y),
-            self.direction(x + size, y),
-            self.direction(x + size, y + size),
-            self.direction(x, y + size),
+            self.corner(x, y),
+            self.corner(x + size, y),
+            self.corner(x + size, y + size),
+            self.corner(x, y + size),
         ];
-        let coords = corners.map(|d| self.texel_coords(d));
+        self.cell_of(corners, x, y, size, depth, scratch)
+    }
+
+    /// [`PixelFootprint::cell`] with its `corners` (clockwise from `(x, y)`) given.
+    fn cell_of(
+        &self,
+        corners: [Corner; 4],
+        x: f64,
+        y: f64,
+        size: f64,
+        depth: u32,
+        scratch: &mut Scratch,
+    ) -> [f64; 3] {
+        let (w, h) = (self.probe.width() as f64, self.probe.height() as f64);
+        let coords = corners.map(|c| c.coords);
+        let corners = corners.map(|c| c.direction);
         let s0 = coords[0].0;
         let unwrapped = coords.map(|(s, t)| {
             let mut ds = s - s0;
@@ -133,7 +203,7 @@ impl<'a> PixelFootprint<'a> {
                 let half = 0.5 * size;
                 let mut sum = [0.0f64; 3];
                 for (dx, dy) in [(0.0, 0.0), (half, 0.0), (0.0, half), (half, half)] {
-                    let part = self.cell(x + dx, y + dy, half, depth + 1);
+                    let part = self.cell(x + dx, y + dy, half, depth + 1, scratch);
                     for k in 0..3 {
                         sum[k] += 0.25 * part[k];
                     }
@@ -148,30 +218,48 @@ impl<'a> PixelFootprint<'a> {
         if total.is_nan() || total <= 0.0 {
             return self.texel(s0.floor() as i64, coords[0].1.floor() as i64);
         }
-        // The parallels' chords may bulge a little past the corners' range: one texel of margin.
-        let (i0, i1) = (lo.0.floor() as i64 - 1, hi.0.floor() as i64 + 1);
+        // Meridians are straight lines in the image and a cell that holds no pole spans the
+        // columns of its corners; the parallels are conics, whose chords may bulge past the
+        // corners' rows by up to `bulge` rows (one row of margin where it is not known).
+        let bulge = self.parallels_bulge(&corners, lo, hi);
+        let margin = |distance: f64| match bulge {
+            Some(bulge) if distance > bulge => 0,
+            _ => 1,
+        };
+        let (i0, i1) = (lo.0.floor() as i64, hi.0.floor() as i64);
         let (j0, j1) = (
-            (lo.1.floor() as i64 - 1).max(0),
-            (hi.1.floor() as i64 + 1).min(h as i64 - 1),
+            (lo.1.floor() as i64 - margin(lo.1 - lo.1.floor())).max(0),
+            (hi.1.floor() as i64 + margin(hi.1.floor() + 1.0 - hi.1)).min(h as i64 - 1),
         );
+        if i0 == i1 && j0 == j1 {
+            // One texel holds the whole cell (most pixels of a view finer than the probe).
+            return self.texel(i0, j0);
+        }
         let mut sum = [0.0f64; 3];
-        let (mut row, mut piece, mut scratch) = (Vec::new(), Vec::new(), Vec::new());
+        let Scratch {
+            row,
+            piece,
+            clipped,
+        } = scratch;
         for j in j0..=j1 {
-            let (c0, c1) = (self.parallel_cos(j), self.parallel_cos(j + 1));
+            let (c0, c1) = (
+                self.parallel_cos[j as usize],
+                self.parallel_cos[j as usize + 1],
+            );
             // theta >= theta_j (c0 |d| - d_y >= 0) and theta <= theta_(j+1).
-            clip(&corners, |d| c0 * d.length() - d.y, &mut scratch);
-            clip(&scratch, |d| d.y - c1 * d.length(), &mut row);
+            clip(&corners, |d| c0 * d.length() - d.y, clipped);
+            clip(clipped, |d| d.y - c1 * d.length(), row);
             if row.len() < 3 {
                 continue;
             }
             for i in i0..=i1 {
-                let (n0, n1) = (self.meridian_normal(i), self.meridian_normal(i + 1));
-                clip(&row, |d| n0.dot(d), &mut scratch);
-                clip(&scratch, |d| -n1.dot(d), &mut piece);
+                let (n0, n1) = (self.meridian(i), self.meridian(i + 1));
+                clip(row, |d| n0.dot(d), clipped);
+                clip(clipped, |d| -n1.dot(d), piece);
                 if piece.len() < 3 {
                     continue;
                 }
-                let share = area(&piece) / total;
+                let share = area(piece) / total;
                 let l = self.texel(i, j);
                 for k in 0..3 {
                     sum[k] += share * l[k];
@@ -181,16 +269,44 @@ impl<'a> PixelFootprint<'a> {
         sum
     }
 
-    /// `cos(theta_j)`, `theta_j = pi j / H` the polar angle of the top of texel row `j`.
-    fn parallel_cos(&self, j: i64) -> f64 {
-        (std::f64::consts::PI * j as f64 / self.probe.height() as f64).cos()
+    /// How far, in texel rows, the parallels' chords between a cell's `corners` (unwrapped
+    /// texel coordinates spanning `lo..hi`) can stray past the corners' rows: twice the bulge
+    /// `l^2 |cot theta| / 8` of a great-circle edge of length `l` (radians) next to the parallel
+    /// at polar angle `theta` (its geodesic curvature is `cot theta`), at the parallel nearest a
+    /// pole that the cell's rows touch. `None` (not known: a row of margin) for rows at a pole
+    /// and for edges over 0.1 radians.
+    fn parallels_bulge(&self, corners: &[DVec3; 4], lo: (f64, f64), hi: (f64, f64)) -> Option<f64> {
+        use std::f64::consts::PI;
+        let h = self.probe.height() as f64;
+        let (top, bottom) = (lo.1.floor(), hi.1.floor() + 1.0);
+        if top < 1.0 || bottom + 1.0 > h {
+            return None;
+        }
+        let unit = corners.map(|d| d.normalize());
+        let chord = (0..4)
+            .map(|k| (unit[k] - unit[(k + 1) % 4]).length())
+            .fold(0.0f64, f64::max);
+        // An arc's angle is 2 asin(c / 2) <= 1.001 c for chords c below 0.1.
+        if chord.is_nan() || chord >= 0.1 {
+            return None;
+        }
+        let length = 1.001 * chord;
+        let cot = |row: f64| {
+            let c = self.parallel_cos[row as usize];
+            (c / (1.0 - c * c).sqrt()).abs()
+        };
+        let bulge_rows = 2.0 * length * length * cot(top).max(cot(bottom)) / 8.0 * h / PI;
+        Some(bulge_rows + 1e-9)
     }
 
-    /// The normal `(cos phi_i, 0, sin phi_i)` of the meridian plane at the left edge of column
-    /// `i` (any integer: columns repeat every `W`), pointing towards increasing `phi`.
-    fn meridian_normal(&self, i: i64) -> DVec3 {
-        let phi = std::f64::consts::TAU * (i as f64 / self.probe.width() as f64 - 0.5);
-        DVec3::new(phi.cos(), 0.0, phi.sin())
+    /// The meridian normal of column `i`: from the table where it covers `i`, else computed
+    /// (the same value either way).
+    fn meridian(&self, i: i64) -> DVec3 {
+        let w = self.probe.width() as i64;
+        usize::try_from(i + w + 2)
+            .ok()
+            .and_then(|k| self.meridian_normals.get(k).copied())
+            .unwrap_or_else(|| meridian_normal(i, w))
     }
 
     /// The radiance of texel `(i, j)`, column wrapped, row clamped, in f64.
@@ -201,6 +317,20 @@ impl<'a> PixelFootprint<'a> {
             .get(i.rem_euclid(w) as usize, j.clamp(0, h - 1) as usize);
         [f64::from(l.r), f64::from(l.g), f64::from(l.b)]
     }
+}
+
+/// `cos(theta_j)`, `theta_j = pi j / H` the polar angle of the top of texel row `j` of a probe
+/// `H` texels high.
+fn parallel_cos(j: i64, height: i64) -> f64 {
+    (std::f64::consts::PI * j as f64 / height as f64).cos()
+}
+
+/// The normal `(cos phi_i, 0, sin phi_i)` of the meridian plane at the left edge of column `i`
+/// (any integer: columns repeat every `W`) of a probe `W` texels wide, pointing towards
+/// increasing `phi`.
+fn meridian_normal(i: i64, width: i64) -> DVec3 {
+    let phi = std::f64::consts::TAU * (i as f64 / width as f64 - 0.5);
+    DVec3::new(phi.cos(), 0.0, phi.sin())
 }
 
 /// Area of a planar polygon of 3-D points (half the length of the vector shoelace sum).
@@ -231,6 +361,46 @@ fn clip(poly: &[DVec3], inside: impl Fn(DVec3) -> f64, out: &mut Vec<DVec3>) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glam::Vec2;
+
+    #[test]
+    fn the_image_is_each_pixel_alone_bit_for_bit() {
+        // Shared corners, tables and reused polygons change nothing: every pixel as `cell` computes
+        // it alone, for a view across the seam and one around the north pole (split cells).
+        let probe = Image::from_fn_par(64, 32, |x, y| {
+            Rgb::new(
+                x as f32 + 0.25,
+                y as f32 * 1.5,
+                ((x * 7 + y * 3) % 11) as f32,
+            )
+        });
+        let (w, h) = (24u32, 18u32);
+        for target in [Vec3::new(0.0, 0.0, 1.0), Vec3::new(0.01, 1.0, 0.02)] {
+            let up = if target.y > 0.5 { Vec3::Z } else { Vec3::Y };
+            let camera = Camera::look_at(
+                Vec3::ZERO,
+                target,
+                up,
+                Vec2::splat(14.0),
+                Vec2::new(12.0, 9.0),
+                (w, h),
+            );
+            let footprint = PixelFootprint::new(&probe, &camera, Mat3::IDENTITY, w, h);
+            let image = footprint.image();
+            for y in 0..h {
+                for x in 0..w {
+                    let sum =
+                        footprint.cell(f64::from(x), f64::from(y), 1.0, 0, &mut Scratch::default());
+                    let alone = Rgb::new(sum[0] as f32, sum[1] as f32, sum[2] as f32);
+                    assert_eq!(
+                        *image.get(x as usize, y as usize),
+                        alone,
+                        "pixel ({x}, {y})"
+                    );
+                }
+            }
+        }
+    }
 
     #[test]
     fn clipping_a_square_into_strips_keeps_its_area() {

@@ -196,20 +196,9 @@ pub fn render(
     let passes = if adaptive.is_some() { 2 } else { 1 };
     let row_done = || progress(rows_done.fetch_add(1, Ordering::Relaxed) + 1, passes * h);
     let sums: Vec<PixelSums> = match adaptive {
-        None => (0..h)
-            .into_par_iter()
-            .flat_map_iter(|y| {
-                let mut hints = ShadowHints::default();
-                let row: Vec<PixelSums> = (0..w)
-                    .map(|x| {
-                        let known = &KnownVisibility::NONE;
-                        sampler.samples(x, y, 0..settings.spp, &mut hints, known)
-                    })
-                    .collect();
-                row_done();
-                row
-            })
-            .collect(),
+        None => per_pixel(w, h, &row_done, |x, y, hints| {
+            sampler.samples(x, y, 0..settings.spp, hints, &KnownVisibility::NONE)
+        }),
         Some(contrast) => {
             // Pass 1: sample 0 of every pixel, the coarse grid's first (every light traced),
             // then the pixels between, which take the lights their coarse neighbours agree on;
@@ -217,38 +206,20 @@ pub fn render(
             // (crate::adaptive).
             let grid = CoarseGrid::new(w, h);
             let (cw, ch) = grid.size();
-            let coarse: Vec<FirstSample> = (0..ch)
-                .into_par_iter()
-                .flat_map_iter(|j| {
-                    let mut hints = ShadowHints::default();
-                    (0..cw)
-                        .map(|i| {
-                            let known = &KnownVisibility::NONE;
-                            let pixel = sampler.samples(2 * i, 2 * j, 0..1, &mut hints, known);
-                            pixel.first_sample()
-                        })
-                        .collect::<Vec<_>>()
-                })
-                .collect();
-            let mut sums: Vec<PixelSums> = (0..h)
-                .into_par_iter()
-                .flat_map_iter(|y| {
-                    let mut hints = ShadowHints::default();
-                    let row: Vec<PixelSums> = (0..w)
-                        .map(|x| {
-                            let known = if CoarseGrid::is_coarse(x, y) {
-                                KnownVisibility::NONE
-                            } else {
-                                grid.known(&coarse, x, y)
-                            };
-                            sampler.samples(x, y, 0..1, &mut hints, &known)
-                        })
-                        .collect();
-                    row_done();
-                    row
-                })
-                .collect();
-            let first: Vec<FirstSample> = sums.iter().map(PixelSums::first_sample).collect();
+            let coarse: Vec<FirstSample> = per_pixel(cw, ch, &|| {}, |i, j, hints| {
+                let known = &KnownVisibility::NONE;
+                let pixel = sampler.samples(2 * i, 2 * j, 0..1, hints, known);
+                pixel.first_sample()
+            });
+            let mut sums: Vec<PixelSums> = per_pixel(w, h, &row_done, |x, y, hints| {
+                let known = if CoarseGrid::is_coarse(x, y) {
+                    KnownVisibility::NONE
+                } else {
+                    grid.known(&coarse, x, y)
+                };
+                sampler.samples(x, y, 0..1, hints, &known)
+            });
+            let first: Vec<FirstSample> = sums.par_iter().map(PixelSums::first_sample).collect();
             sums.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
                 let mut hints = ShadowHints::default();
                 for (x, pixel) in row.iter_mut().enumerate() {
@@ -267,56 +238,8 @@ pub fn render(
         spp: settings.spp,
         ..RenderStats::default()
     };
-    let mut composite = Vec::with_capacity(w * h);
-    let mut with_objects = Vec::with_capacity(w * h);
-    let mut without_objects = Vec::with_capacity(w * h);
-    let mut coverage = Vec::with_capacity(w * h);
     let mut object_samples = 0u64;
-    for (sums, &b) in sums.iter().zip(background.pixels()) {
-        let n = sums.samples as f32;
-        let other = sums.samples - sums.object_samples;
-        let c = match settings.composite {
-            CompositeRule::Difference => {
-                b * (other as f32 / n) + (sums.object + sums.difference) / n
-            }
-            CompositeRule::Ratio => {
-                let ratio = |w: f32, v: f32, d: f32, b: f32| {
-                    if d == 0.0 {
-                        b
-                    } else if v > 0.0 {
-                        b * (w / v)
-                    } else {
-                        b + d / other.max(1) as f32
-                    }
-                };
-                let real = Rgb::new(
-                    ratio(
-                        sums.real_with.r,
-                        sums.real_without.r,
-                        sums.difference.r,
-                        b.r,
-                    ),
-                    ratio(
-                        sums.real_with.g,
-                        sums.real_without.g,
-                        sums.difference.g,
-                        b.g,
-                    ),
-                    ratio(
-                        sums.real_with.b,
-                        sums.real_without.b,
-                        sums.difference.b,
-                        b.b,
-                    ),
-                );
-                real * (other as f32 / n) + sums.object / n
-            }
-        };
-        composite.push(c.map(|v| v.max(0.0)));
-        let bg = b * sums.background_samples as f32;
-        with_objects.push((sums.with + bg) / n);
-        without_objects.push((sums.without + bg) / n);
-        coverage.push(sums.object_samples as f32 / n);
+    for sums in &sums {
         object_samples += u64::from(sums.object_samples);
         stats.paths += u64::from(sums.samples);
         stats.refined_pixels += u64::from(sums.samples == settings.spp);
@@ -324,6 +247,22 @@ pub fn render(
         stats.rays += sums.rays;
     }
     stats.object_coverage = object_samples as f64 / stats.paths.max(1) as f64;
+    // The output layers, each pixel from its sums and its background, in parallel.
+    let layer = |f: &(dyn Fn(&PixelSums, Rgb) -> Rgb + Sync)| -> Vec<Rgb> {
+        sums.par_iter()
+            .zip(background.pixels().par_iter())
+            .map(|(sums, &b)| f(sums, b))
+            .collect()
+    };
+    let composite = layer(&|sums, b| sums.composite(b, settings.composite));
+    let with_objects =
+        layer(&|sums, b| (sums.with + b * sums.background_samples as f32) / sums.samples as f32);
+    let without_objects =
+        layer(&|sums, b| (sums.without + b * sums.background_samples as f32) / sums.samples as f32);
+    let coverage: Vec<f32> = sums
+        .par_iter()
+        .map(|sums| sums.object_samples as f32 / sums.samples as f32)
+        .collect();
     let image =
         |data| Image::from_vec(w, h, data).map_err(|e| RenderError::Parameter(e.to_string()));
     Ok(RenderOutput {
@@ -340,7 +279,74 @@ pub fn render(
 /// Largest output, pixels (a 16384 x 8192 panorama).
 pub const MAX_PIXELS: usize = 16384 * 8192;
 
+/// `f(x, y, hints)` for every pixel of a `w x h` grid, row-major, in parallel: written in
+/// place (no per-row vectors to join), `hints` one shadow cache per rayon job, `row_done` after
+/// each row's last pixel.
+fn per_pixel<T: Send>(
+    w: usize,
+    h: usize,
+    row_done: &(dyn Fn() + Sync),
+    f: impl Fn(usize, usize, &mut ShadowHints) -> T + Sync,
+) -> Vec<T> {
+    (0..w * h)
+        .into_par_iter()
+        .with_min_len(w.max(1))
+        .map_init(ShadowHints::default, |hints, i| {
+            let (x, y) = (i % w, i / w);
+            let value = f(x, y, hints);
+            if x + 1 == w {
+                row_done();
+            }
+            value
+        })
+        .collect()
+}
+
 impl PixelSums {
+    /// The composited pixel over background `b` by `rule` (module notes), clamped at 0.
+    fn composite(&self, b: Rgb, rule: CompositeRule) -> Rgb {
+        let n = self.samples as f32;
+        let other = self.samples - self.object_samples;
+        let c = match rule {
+            CompositeRule::Difference => {
+                b * (other as f32 / n) + (self.object + self.difference) / n
+            }
+            CompositeRule::Ratio => {
+                let ratio = |w: f32, v: f32, d: f32, b: f32| {
+                    if d == 0.0 {
+                        b
+                    } else if v > 0.0 {
+                        b * (w / v)
+                    } else {
+                        b + d / other.max(1) as f32
+                    }
+                };
+                let real = Rgb::new(
+                    ratio(
+                        self.real_with.r,
+                        self.real_without.r,
+                        self.difference.r,
+                        b.r,
+                    ),
+                    ratio(
+                        self.real_with.g,
+                        self.real_without.g,
+                        self.difference.g,
+                        b.g,
+                    ),
+                    ratio(
+                        self.real_with.b,
+                        self.real_without.b,
+                        self.difference.b,
+                        b.b,
+                    ),
+                );
+                real * (other as f32 / n) + self.object / n
+            }
+        };
+        c.map(|v| v.max(0.0))
+    }
+
     /// What the pixel's one sample saw (adaptive antialiasing's first pass).
     fn first_sample(&self) -> FirstSample {
         let primary = if self.object_samples > 0 {

@@ -52,6 +52,8 @@ pub struct SobolStream {
     pixel_key: u64,
     /// Pairs drawn so far.
     pair: u64,
+    /// The Sobol tables, looked up once per stream (not once per pair).
+    tables: &'static SobolTables,
 }
 
 impl SobolStream {
@@ -62,10 +64,12 @@ impl SobolStream {
             index_rev: (sample % SOBOL_MAX_SAMPLES).reverse_bits(),
             pixel_key: splitmix64(seed ^ splitmix64(pixel ^ 0x243f_6a88_85a3_08d3)),
             pair: 0,
+            tables: LazyLock::force(&TABLES),
         }
     }
 
     /// The seed of the next pair.
+    #[inline]
     fn next_seed(&mut self) -> u32 {
         let seed = splitmix64(self.pixel_key ^ self.pair.wrapping_mul(0x9e37_79b9_7f4a_7c15));
         self.pair += 1;
@@ -73,28 +77,31 @@ impl SobolStream {
     }
 
     /// The next pair: point `index` of the pair's scrambled (0,2)-sequence (dimensions 0 and 1).
+    #[inline]
     pub fn next_2d(&mut self) -> [f32; 2] {
         let seed = self.next_seed();
         let rev = shuffled_rev_index(self.index_rev, seed);
         let base = seed.wrapping_mul(SEED_MULTIPLIER);
         [
-            scrambled(TABLES.get(0, rev), base ^ DIMENSION_KEYS[0]),
-            scrambled(TABLES.get(1, rev), base ^ DIMENSION_KEYS[1]),
+            scrambled(self.tables.get(0, rev), base ^ DIMENSION_KEYS[0]),
+            scrambled(self.tables.get(1, rev), base ^ DIMENSION_KEYS[1]),
         ]
     }
 
     /// Passes over the next pair without computing it: the pairs after it are those a
     /// [`SobolStream::next_2d`] here would have left.
+    #[inline]
     pub fn skip_2d(&mut self) {
         self.pair += 1;
     }
 
     /// The next number: the first coordinate of a fresh pair.
+    #[inline]
     pub fn next_1d(&mut self) -> f32 {
         let seed = self.next_seed();
         let rev = shuffled_rev_index(self.index_rev, seed);
         scrambled(
-            TABLES.get(0, rev),
+            self.tables.get(0, rev),
             seed.wrapping_mul(SEED_MULTIPLIER) ^ DIMENSION_KEYS[0],
         )
     }
@@ -124,6 +131,12 @@ fn scrambled(sobol_rev: u32, key: u32) -> f32 {
 /// (the crate uses the top 16 reversed bits only). Linear over GF(2), so any index is the XOR of
 /// one entry of each.
 struct SobolTables([[[u32; 256]; 2]; 2]);
+
+impl std::fmt::Debug for SobolTables {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("SobolTables (dimensions 0 and 1)")
+    }
+}
 
 impl SobolTables {
     fn new() -> Self {

@@ -54,6 +54,7 @@ use glam::Vec3;
 use ibl_core::Rgb;
 use ibl_scene::bvh::OccluderHint;
 use ibl_scene::{Hit, Ray, Scene, ShadowKind, SurfacePoint};
+use rayon::prelude::*;
 
 use crate::lighting::{Ambient, Illumination, LightList, Lighting};
 use crate::material::Bsdf;
@@ -365,8 +366,9 @@ impl<'a> Tracer<'a> {
             Illumination::Lights(list) | Illumination::Hybrid(list, _)
                 if list.shadows == ShadowKind::Soft =>
             {
+                // Tabulated in parallel: 513 closed forms per cone.
                 list.lights
-                    .iter()
+                    .par_iter()
                     .map(|l| l.cone.map(|core| LightShading::new(core, l.halo)))
                     .collect()
             }
