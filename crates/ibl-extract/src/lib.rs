@@ -8,6 +8,7 @@ pub mod adaptive_median_cut;
 mod cholesky;
 pub mod hybrid;
 pub mod irradiance_optimization;
+mod light_cells;
 pub mod lightgen;
 mod lune_gram;
 pub mod median_cut;

@@ -1,0 +1,300 @@
+//! The probe's pixels nearest each light: its **cell**, the region of the sphere (a cell of the
+//! spherical Voronoi diagram of the light directions) whose radiance the light stands for, and
+//! the source that sizes its soft shadow.
+//!
+//! A fitted light (irradiance optimisation) has a direction and a power but no pixels: the fit
+//! works on irradiance, and the paper gives every light the same small disc `A` (Madsen &
+//! Laursen 2006, section 4.4). Shadowed by that disc, 256 fitted lights render an indoor probe's
+//! broad windows as 256 hard shadows. Given its cell, a fitted light is sized as a LightGen
+//! cluster is (a cluster is the pixels nearest its centre, the same kind of cell): its source
+//! solid angle is the cell's, its spread ([`ibl_light::spread`]) is the half-energy cone of the
+//! cell's power about the light's direction, and its core fraction fits the cell's power to a
+//! core and a halo ([`WIDEST_CORE_IN_A_CLUSTER`]). The light's power `I` is the fit's; its
+//! radiance becomes `I / Omega_cell`.
+//!
+//! # Cost
+//! The nearest light of each pixel is found exactly without testing every light: the probe is cut
+//! into tiles of [`TILE`] x [`TILE`] pixels, each with a centre direction `c` and the largest angle
+//! `r` from `c` to one of its pixel centres. With `a` the angle from `c` to its nearest light, a
+//! pixel's nearest light is within `a + 2 r` of `c` (triangle inequality: the pixel is within `r`
+//! of `c`, its nearest light within `a + r` of the pixel), so only those lights are tested. Cost
+//! O(W H k + T N) for `k` candidates a tile and `T` tiles; the tiles are taken a row of tiles at
+//! a time in parallel and their histograms merged in row order, so the result does not depend on
+//! the thread count. Ties go to the lower light index, as a scan of every light would give.
+
+use glam::DVec3;
+use ibl_core::{Image, Rgb};
+use ibl_light::Light;
+use ibl_light::spread::{SpreadHistogram, WIDEST_CORE_IN_A_CLUSTER};
+use rayon::prelude::*;
+
+use crate::ExtractError;
+use crate::region_stats::{Grid, core_fraction, each_pixel};
+
+/// Side of a tile, pixels.
+const TILE: usize = 16;
+
+/// Margin added to the candidate angle, radians: it covers the rounding of the dot products and
+/// of `acos`, at most about 2e-8 rad (near an angle of 0, where `acos` is steepest: a dot product
+/// off by 2e-16 moves `acos(1 - e)` by up to 2e-8).
+const MARGIN_RAD: f64 = 1e-7;
+
+/// One light's share of the probe: its cell's solid angle (sr) and its power's histogram about
+/// the light's direction.
+#[derive(Clone, Debug)]
+struct Cell {
+    solid_angle_sr: f64,
+    histogram: SpreadHistogram,
+}
+
+/// The cells of one row of tiles: per light touched, its slot in `cells`.
+struct RowCells {
+    slot: Vec<u32>,
+    cells: Vec<(usize, Cell)>,
+}
+
+impl RowCells {
+    fn new(lights: usize) -> RowCells {
+        RowCells {
+            slot: vec![u32::MAX; lights],
+            cells: Vec::new(),
+        }
+    }
+
+    fn cell(&mut self, light: usize) -> &mut Cell {
+        if self.slot[light] == u32::MAX {
+            self.slot[light] = self.cells.len() as u32;
+            self.cells.push((
+                light,
+                Cell {
+                    solid_angle_sr: 0.0,
+                    histogram: SpreadHistogram::new(),
+                },
+            ));
+        }
+        &mut self.cells[self.slot[light] as usize].1
+    }
+}
+
+/// Sizes each of `lights` by its cell of `probe` (lat-long, world frame; see the module doc):
+/// sets its `solid_angle_sr` to the cell's, its radiance to `I / Omega_cell`, its spread and its
+/// core fraction. A light whose cell holds no pixel, or no energy, keeps its solid angle and gets
+/// no spread. Directions need not be unit (they are normalised for the search; a zero or
+/// non-finite direction gets no cell). Cost: module doc.
+pub(crate) fn size_by_cells(probe: &Image<Rgb>, lights: &mut [Light]) -> Result<(), ExtractError> {
+    if lights.is_empty() {
+        return Ok(());
+    }
+    let grid = Grid::new(probe)?;
+    let dirs: Vec<Option<DVec3>> = lights.iter().map(|l| l.direction.try_normalize()).collect();
+    let tile_rows: Vec<RowCells> = (0..grid.h.div_ceil(TILE))
+        .into_par_iter()
+        .map(|t| tile_row(probe, &grid, &dirs, t))
+        .collect();
+    let mut cells = vec![
+        Cell {
+            solid_angle_sr: 0.0,
+            histogram: SpreadHistogram::new(),
+        };
+        lights.len()
+    ];
+    for row in &tile_rows {
+        for (k, c) in &row.cells {
+            cells[*k].solid_angle_sr += c.solid_angle_sr;
+            cells[*k].histogram.merge(&c.histogram);
+        }
+    }
+    for (l, c) in lights.iter_mut().zip(&cells) {
+        let spread = c.histogram.spread_sr();
+        if c.solid_angle_sr > 0.0 && spread.is_some() {
+            let a = c.solid_angle_sr;
+            let i = l.irradiance.to_array();
+            l.radiance = Rgb::new((i[0] / a) as f32, (i[1] / a) as f32, (i[2] / a) as f32);
+            l.solid_angle_sr = a;
+            l.spread_sr = spread;
+            l.core_fraction = core_fraction(&c.histogram, l, WIDEST_CORE_IN_A_CLUSTER);
+        }
+    }
+    Ok(())
+}
+
+/// The cells of tile row `t`: every pixel of rows `t TILE .. (t + 1) TILE` given to its nearest
+/// light.
+fn tile_row(probe: &Image<Rgb>, grid: &Grid, dirs: &[Option<DVec3>], t: usize) -> RowCells {
+    let mut out = RowCells::new(dirs.len());
+    let rows = t * TILE..((t + 1) * TILE).min(grid.h);
+    let mut candidates: Vec<(usize, DVec3)> = Vec::with_capacity(dirs.len());
+    for x0 in (0..grid.w).step_by(TILE) {
+        let cols = x0..(x0 + TILE).min(grid.w);
+        let centre = grid.dir(
+            (cols.start + cols.end - 1) / 2,
+            (rows.start + rows.end - 1) / 2,
+        );
+        let mut min_cos: f64 = 1.0;
+        for j in rows.clone() {
+            for i in cols.clone() {
+                min_cos = min_cos.min(centre.dot(grid.dir(i, j)));
+            }
+        }
+        let r = min_cos.clamp(-1.0, 1.0).acos();
+        let nearest = dirs
+            .iter()
+            .flatten()
+            .map(|d| centre.dot(*d))
+            .fold(f64::NEG_INFINITY, f64::max);
+        if nearest == f64::NEG_INFINITY {
+            return out;
+        }
+        let reach = nearest.clamp(-1.0, 1.0).acos() + 2.0 * r + MARGIN_RAD;
+        let least_cos = if reach >= std::f64::consts::PI {
+            f64::NEG_INFINITY
+        } else {
+            reach.cos()
+        };
+        candidates.clear();
+        candidates.extend(
+            dirs.iter()
+                .enumerate()
+                .filter_map(|(k, d)| d.map(|d| (k, d)))
+                .filter(|(_, d)| centre.dot(*d) >= least_cos),
+        );
+        for j in rows.clone() {
+            let sr = grid.row_sr[j];
+            let row = &probe.row(j)[cols.clone()];
+            each_pixel(row, grid.clean[j], cols.clone(), |i, _, y| {
+                let p = grid.dir(i, j);
+                let (mut best, mut best_cos) = (candidates[0].0, f64::NEG_INFINITY);
+                for &(k, d) in &candidates {
+                    let c = p.dot(d);
+                    if c > best_cos {
+                        (best, best_cos) = (k, c);
+                    }
+                }
+                let cell = out.cell(best);
+                cell.solid_angle_sr += sr;
+                cell.histogram.add(1.0 - best_cos, y * sr, sr);
+            });
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use ibl_core::rgb::Rgb64;
+
+    fn light(direction: DVec3) -> Light {
+        Light {
+            direction,
+            radiance: Rgb::new(1.0, 1.0, 1.0),
+            solid_angle_sr: 2.392e-4,
+            irradiance: Rgb64::from_array([2.392e-4; 3]),
+            region: None,
+            spread_sr: None,
+            core_fraction: None,
+        }
+    }
+
+    fn probe(w: usize, h: usize, f: impl Fn(usize, usize) -> f32 + Sync) -> Image<Rgb> {
+        Image::from_fn_par(w, h, |i, j| {
+            let v = f(i, j);
+            Rgb::new(v, v, v)
+        })
+    }
+
+    /// The nearest light of every pixel by testing every light (lowest index on ties).
+    fn brute_force(grid: &Grid, dirs: &[DVec3]) -> Vec<f64> {
+        let mut sr = vec![0.0; dirs.len()];
+        for j in 0..grid.h {
+            for i in 0..grid.w {
+                let p = grid.dir(i, j);
+                let mut best = (0, f64::NEG_INFINITY);
+                for (k, d) in dirs.iter().enumerate() {
+                    if p.dot(*d) > best.1 {
+                        best = (k, p.dot(*d));
+                    }
+                }
+                sr[best.0] += grid.row_sr[j];
+            }
+        }
+        sr
+    }
+
+    #[test]
+    fn the_tiles_find_every_pixels_nearest_light() {
+        // 300 lights (Fibonacci, so some lie near tile edges and poles) on a probe whose size is
+        // not a multiple of the tile: each cell's solid angle equals the brute-force one's, and
+        // the cells cover the sphere (4 pi to rounding).
+        let img = probe(200, 100, |_, _| 1.0);
+        let dirs = ibl_core::fibonacci_normals(300);
+        let mut lights: Vec<Light> = dirs.iter().map(|d| light(*d)).collect();
+        size_by_cells(&img, &mut lights).unwrap();
+        let grid = Grid::new(&img).unwrap();
+        let expected = brute_force(&grid, &dirs);
+        let mut total = 0.0;
+        for (l, e) in lights.iter().zip(&expected) {
+            // Summation order differs (tile rows merged): equal to 1e-12 relative.
+            assert!(
+                (l.solid_angle_sr - e).abs() <= 1e-12 * e,
+                "{} vs {e}",
+                l.solid_angle_sr
+            );
+            total += l.solid_angle_sr;
+        }
+        assert!((total - 4.0 * std::f64::consts::PI).abs() < 1e-9, "{total}");
+    }
+
+    #[test]
+    fn a_uniform_probe_gives_each_light_its_cell() {
+        // Two opposite lights on a uniform probe: each holds a hemisphere (2 pi sr), radiance
+        // I / 2 pi, and a spread of the hemisphere's half-energy cone (1 - cos t_h = 1/2: 2 pi)
+        // plus the pixels' mean extent, to the histogram's 9 % (spread module doc).
+        let img = probe(64, 32, |_, _| 1.0);
+        let mut lights = vec![light(DVec3::Y), light(-DVec3::Y)];
+        size_by_cells(&img, &mut lights).unwrap();
+        for l in &lights {
+            let two_pi = 2.0 * std::f64::consts::PI;
+            assert!((l.solid_angle_sr - two_pi).abs() < 1e-9);
+            assert!((f64::from(l.radiance.g) - 2.392e-4 / two_pi).abs() < 1e-9);
+            let s = l.spread_sr.unwrap();
+            assert!((s - two_pi).abs() < 0.09 * two_pi, "{s}");
+            assert_eq!(l.core_fraction, Some(1.0));
+        }
+    }
+
+    #[test]
+    fn a_sun_in_a_dim_sky_keeps_a_narrow_core_and_a_halo() {
+        // One light at a bright 3 x 3 pixel patch of a dim probe: its cell is the whole sphere,
+        // its core the patch's extent, and most of the power is in the core.
+        let img = probe(128, 64, |i, j| {
+            if (63..66).contains(&i) && (20..23).contains(&j) {
+                1.0e4
+            } else {
+                0.1
+            }
+        });
+        let grid = Grid::new(&img).unwrap();
+        let mut lights = vec![light(grid.dir(64, 21))];
+        size_by_cells(&img, &mut lights).unwrap();
+        let l = &lights[0];
+        assert!((l.solid_angle_sr - 4.0 * std::f64::consts::PI).abs() < 1e-9);
+        let patch = 9.0 * grid.row_sr[21];
+        assert!(l.spread_sr.unwrap() < 4.0 * patch, "{:?}", l.spread_sr);
+        let f = l.core_fraction.unwrap();
+        assert!(f > 0.8 && f < 1.0, "{f}");
+    }
+
+    #[test]
+    fn a_light_without_pixels_or_direction_is_left_as_it_was() {
+        // Two lights in one direction: the first takes every pixel (ties to the lower index);
+        // the second, and one without a direction, keep the disc they had.
+        let img = probe(32, 16, |_, _| 1.0);
+        let mut lights = vec![light(DVec3::X), light(DVec3::X), light(DVec3::ZERO)];
+        let before = lights.clone();
+        size_by_cells(&img, &mut lights).unwrap();
+        assert!((lights[0].solid_angle_sr - 4.0 * std::f64::consts::PI).abs() < 1e-9);
+        assert_eq!(lights[1], before[1]);
+        assert_eq!(lights[2], before[2]);
+    }
+}
