@@ -85,6 +85,39 @@ fn headless_frames_are_written_with_their_timings() {
 }
 
 #[test]
+fn an_adapter_that_cannot_draw_the_scene_is_refused_by_name() {
+    // Mesa's OpenGL adapter (llvmpipe, what wgpu finds where Vulkan is not installed) cannot
+    // multisample the geometry pass's R32Float targets: the first frame used to fail with a
+    // validation error ("Format R32Float does not support multisampling"). With the GL backend
+    // forced, the frame is either drawn (an adapter that can) or refused before any work, naming
+    // the adapter and the format, as "no usable GPU adapter" (status 1), never a GPU error.
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("frame.png");
+    let out = Command::new(common::ibl_binary())
+        .env("WGPU_BACKEND", "gl")
+        .args([
+            "view",
+            &scene("bunny-sky.toml"),
+            "--headless",
+            "--size",
+            "32x24",
+            "-o",
+            png.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    let err = stderr(&out);
+    if out.status.success() {
+        assert!(png.exists());
+    } else {
+        assert_eq!(out.status.code(), Some(1), "{err}");
+        assert!(err.contains("no usable GPU adapter"), "{err}");
+        assert!(!err.contains("Validation Error"), "{err}");
+        assert!(!png.exists());
+    }
+}
+
+#[test]
 fn a_scene_with_a_luminaire_is_drawn_with_its_light() {
     // bunny-lamp: bunny-sky and the umbrella downlight (docs/SCENES.md, `[[luminaire]]`). The
     // viewer draws it (crates/ibl-viewer/tests/against_cpu.rs compares it with `ibl render`);

@@ -15,21 +15,13 @@
 use ibl_core::{Image, Rgb};
 
 use crate::ViewerError;
-use crate::gpu::{DEPTH_FORMAT, DISPLAY_FORMAT, GpuContext, HDR_FORMAT};
+use crate::gpu::{DEPTH_FORMAT, DISPLAY_FORMAT, GBUFFER_FORMATS, GpuContext, HDR_FORMAT};
 use crate::textures::padded_bytes_per_row;
 
 /// Samples per pixel of the scene pass.
 pub const MSAA_SAMPLES: u32 = 4;
 /// Format of the object-coverage target.
 pub const COVERAGE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R8Unorm;
-/// Formats of the geometry pass's targets: view depth and surface id (one 32-bit float each),
-/// the octahedral shading and geometric normals (`Rgba16Float`, about 1e-3 rad). Formats every
-/// device can multisample, 16 bytes a sample in all.
-pub const GBUFFER_FORMATS: [wgpu::TextureFormat; 3] = [
-    wgpu::TextureFormat::R32Float,
-    wgpu::TextureFormat::R32Float,
-    wgpu::TextureFormat::Rgba16Float,
-];
 /// Format of the overlay target.
 pub const OVERLAY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 

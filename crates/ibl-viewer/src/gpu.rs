@@ -18,6 +18,15 @@ pub const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 /// Format of the tone-mapped picture (sRGB-encoded values in a UNORM texture, what egui shows).
 pub const DISPLAY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+/// Formats of the scene's geometry pass (`frame_targets.rs`), 4x multisampled: view depth and
+/// surface id (one 32-bit float each), the octahedral shading and geometric normals
+/// (`Rgba16Float`, about 1e-3 rad), 16 bytes a sample in all. Vulkan devices multisample all
+/// three; [`GpuContext::open`] refuses an adapter that cannot.
+pub const GBUFFER_FORMATS: [wgpu::TextureFormat; 3] = [
+    wgpu::TextureFormat::R32Float,
+    wgpu::TextureFormat::R32Float,
+    wgpu::TextureFormat::Rgba16Float,
+];
 
 /// What the adapter is, for status lines and reports.
 #[derive(Clone, Debug, PartialEq, Eq, serde::Serialize)]
@@ -95,9 +104,15 @@ pub fn device_descriptor(adapter: &wgpu::Adapter) -> wgpu::DeviceDescriptor<'sta
     }
 }
 
-/// Whether `adapter` can render what the viewer renders (4x MSAA of the HDR and depth formats).
+/// Whether `adapter` can render what the viewer renders (4x MSAA of the HDR, depth and geometry
+/// formats). Mesa's OpenGL adapter (llvmpipe, what wgpu finds where Vulkan is not installed)
+/// cannot multisample `R32Float`: refused here with that reason, instead of a validation error
+/// at the first frame.
 fn check_adapter(adapter: &wgpu::Adapter) -> Result<(), String> {
-    for format in [HDR_FORMAT, DEPTH_FORMAT] {
+    for format in [HDR_FORMAT, DEPTH_FORMAT]
+        .into_iter()
+        .chain(GBUFFER_FORMATS)
+    {
         let flags = adapter.get_texture_format_features(format).flags;
         if !flags.sample_count_supported(4) {
             return Err(format!("{format:?} cannot be multisampled 4x"));

@@ -14,7 +14,8 @@
 use std::collections::HashMap;
 
 use crate::environment_maps::EnvironmentMaps;
-use crate::frame_targets::{COVERAGE_FORMAT, FrameTargets, GBUFFER_FORMATS, MSAA_SAMPLES};
+use crate::frame_targets::{COVERAGE_FORMAT, FrameTargets, MSAA_SAMPLES};
+use crate::gpu::GBUFFER_FORMATS;
 use crate::gpu::{DEPTH_FORMAT, GpuContext, HDR_FORMAT};
 use crate::gpu_scene::GpuScene;
 use crate::light_tiles::LightTiles;
