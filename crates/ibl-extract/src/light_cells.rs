@@ -29,7 +29,7 @@ use ibl_light::spread::{SpreadHistogram, WIDEST_CORE_IN_A_CLUSTER};
 use rayon::prelude::*;
 
 use crate::ExtractError;
-use crate::region_stats::{Grid, core_fraction, each_pixel};
+use crate::region_stats::{Grid, core_fraction, each_pixel, light};
 
 /// Side of a tile, pixels.
 const TILE: usize = 16;
@@ -41,7 +41,7 @@ const MARGIN_RAD: f64 = 1e-7;
 
 /// One light's share of the probe: its cell's solid angle (sr) and its power's histogram about
 /// the light's direction.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Default)]
 struct Cell {
     solid_angle_sr: f64,
     histogram: SpreadHistogram,
@@ -64,13 +64,7 @@ impl RowCells {
     fn cell(&mut self, light: usize) -> &mut Cell {
         if self.slot[light] == u32::MAX {
             self.slot[light] = self.cells.len() as u32;
-            self.cells.push((
-                light,
-                Cell {
-                    solid_angle_sr: 0.0,
-                    histogram: SpreadHistogram::new(),
-                },
-            ));
+            self.cells.push((light, Cell::default()));
         }
         &mut self.cells[self.slot[light] as usize].1
     }
@@ -82,22 +76,16 @@ impl RowCells {
 /// no spread. Directions need not be unit (they are normalised for the search; a zero or
 /// non-finite direction gets no cell). Cost: module doc.
 pub(crate) fn size_by_cells(probe: &Image<Rgb>, lights: &mut [Light]) -> Result<(), ExtractError> {
-    if lights.is_empty() {
+    let dirs: Vec<Option<DVec3>> = lights.iter().map(|l| l.direction.try_normalize()).collect();
+    if dirs.iter().all(Option::is_none) {
         return Ok(());
     }
     let grid = Grid::new(probe)?;
-    let dirs: Vec<Option<DVec3>> = lights.iter().map(|l| l.direction.try_normalize()).collect();
     let tile_rows: Vec<RowCells> = (0..grid.h.div_ceil(TILE))
         .into_par_iter()
         .map(|t| tile_row(probe, &grid, &dirs, t))
         .collect();
-    let mut cells = vec![
-        Cell {
-            solid_angle_sr: 0.0,
-            histogram: SpreadHistogram::new(),
-        };
-        lights.len()
-    ];
+    let mut cells = vec![Cell::default(); lights.len()];
     for row in &tile_rows {
         for (k, c) in &row.cells {
             cells[*k].solid_angle_sr += c.solid_angle_sr;
@@ -107,11 +95,13 @@ pub(crate) fn size_by_cells(probe: &Image<Rgb>, lights: &mut [Light]) -> Result<
     for (l, c) in lights.iter_mut().zip(&cells) {
         let spread = c.histogram.spread_sr();
         if c.solid_angle_sr > 0.0 && spread.is_some() {
-            let a = c.solid_angle_sr;
-            let i = l.irradiance.to_array();
-            l.radiance = Rgb::new((i[0] / a) as f32, (i[1] / a) as f32, (i[2] / a) as f32);
-            l.solid_angle_sr = a;
-            l.spread_sr = spread;
+            *l = light(
+                l.direction,
+                l.irradiance.to_array(),
+                c.solid_angle_sr,
+                spread,
+                l.region,
+            );
             l.core_fraction = core_fraction(&c.histogram, l, WIDEST_CORE_IN_A_CLUSTER);
         }
     }
@@ -124,6 +114,7 @@ fn tile_row(probe: &Image<Rgb>, grid: &Grid, dirs: &[Option<DVec3>], t: usize) -
     let mut out = RowCells::new(dirs.len());
     let rows = t * TILE..((t + 1) * TILE).min(grid.h);
     let mut candidates: Vec<(usize, DVec3)> = Vec::with_capacity(dirs.len());
+    let mut dots: Vec<f64> = Vec::with_capacity(dirs.len());
     for x0 in (0..grid.w).step_by(TILE) {
         let cols = x0..(x0 + TILE).min(grid.w);
         let centre = grid.dir(
@@ -137,14 +128,13 @@ fn tile_row(probe: &Image<Rgb>, grid: &Grid, dirs: &[Option<DVec3>], t: usize) -
             }
         }
         let r = min_cos.clamp(-1.0, 1.0).acos();
-        let nearest = dirs
-            .iter()
-            .flatten()
-            .map(|d| centre.dot(*d))
-            .fold(f64::NEG_INFINITY, f64::max);
-        if nearest == f64::NEG_INFINITY {
-            return out;
-        }
+        // The centre's cosine to each light (-inf for a light without a direction).
+        dots.clear();
+        dots.extend(
+            dirs.iter()
+                .map(|d| d.map_or(f64::NEG_INFINITY, |d| centre.dot(d))),
+        );
+        let nearest = dots.iter().copied().fold(f64::NEG_INFINITY, f64::max);
         let reach = nearest.clamp(-1.0, 1.0).acos() + 2.0 * r + MARGIN_RAD;
         let least_cos = if reach >= std::f64::consts::PI {
             f64::NEG_INFINITY
@@ -154,9 +144,10 @@ fn tile_row(probe: &Image<Rgb>, grid: &Grid, dirs: &[Option<DVec3>], t: usize) -
         candidates.clear();
         candidates.extend(
             dirs.iter()
+                .zip(&dots)
                 .enumerate()
-                .filter_map(|(k, d)| d.map(|d| (k, d)))
-                .filter(|(_, d)| centre.dot(*d) >= least_cos),
+                .filter(|(_, (_, c))| **c >= least_cos)
+                .filter_map(|(k, (d, _))| d.map(|d| (k, d))),
         );
         for j in rows.clone() {
             let sr = grid.row_sr[j];
