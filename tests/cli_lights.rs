@@ -548,3 +548,62 @@ fn hybrid_lights_carry_an_sh_ambient_in_json() {
     assert_eq!(r.status.code(), Some(2));
     assert!(!gltf.exists());
 }
+
+#[test]
+fn fitted_lights_share_the_hemispheres_unless_asked_for_the_paper_fit() {
+    // `ibl lights` fits irradiance optimisation's lights above and below the horizon apart (for
+    // renders over a ground), and records how many went above; `--fit-domain sphere` is the
+    // paper's single fit, as `ibl eval` scores it by default; an unknown domain exits 2.
+    let dir = tempfile::tempdir().unwrap();
+    let run = |domain: Option<&str>, name: &str| {
+        let out = dir.path().join(name);
+        let mut args = vec![
+            "lights".to_string(),
+            probe("night.exr"),
+            "-n".into(),
+            "6".into(),
+            "--method".into(),
+            "irradiance-optimization".into(),
+            "-o".into(),
+            s(&out),
+        ];
+        if let Some(d) = domain {
+            args.extend(["--fit-domain".to_string(), d.to_string()]);
+        }
+        let refs: Vec<&str> = args.iter().map(String::as_str).collect();
+        let o = ibl(&refs);
+        assert!(o.status.success(), "{}", stderr(&o));
+        read_json(&out)
+    };
+    let apart = run(None, "apart.json");
+    let above = apart["method"]["parameters"]["lights_above_horizon"]
+        .as_f64()
+        .unwrap();
+    let lights = apart["lights"].as_array().unwrap();
+    let up = lights
+        .iter()
+        .filter(|l| vec3(&l["direction"])[1] > 0.0)
+        .count();
+    assert!(
+        (1.0..=5.0).contains(&above) && up as f64 == above,
+        "{above} {up}"
+    );
+    let whole = run(Some("sphere"), "whole.json");
+    assert!(
+        whole["method"]["parameters"]
+            .get("lights_above_horizon")
+            .is_none()
+    );
+    let o = ibl(&[
+        "lights",
+        &probe("night.exr"),
+        "-n",
+        "6",
+        "--fit-domain",
+        "ground",
+        "-o",
+        &s(&dir.path().join("x.json")),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("--fit-domain"), "{}", stderr(&o));
+}

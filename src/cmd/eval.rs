@@ -57,6 +57,10 @@ pub struct EvalArgs {
     /// the largest N).
     #[arg(long, value_name = "N")]
     pub overlay_n: Option<usize>,
+    /// Irradiance optimisation only: fit the whole sphere at once (`sphere`, the paper's fit and
+    /// its lowest unshadowed error) or the hemispheres apart (`hemispheres`, as renders use it).
+    #[arg(long, value_enum, default_value = "sphere", value_name = "DOMAIN")]
+    pub fit_domain: crate::cmd::lights::FitDomainArg,
 }
 
 /// Runs `ibl eval`.
@@ -69,6 +73,7 @@ pub fn run(args: &EvalArgs) -> anyhow::Result<()> {
         args.overlay_n,
     )?;
     settings.mapping = args.probe_mapping.mapping()?;
+    settings.fit_domain = args.fit_domain.domain();
     let report = evaluate(&args.probes, &settings, &args.out, &Bars::default())?;
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);

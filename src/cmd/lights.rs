@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use clap::{ArgGroup, Args, ValueEnum};
 use ibl_core::FramePreset;
-use ibl_extract::ExtractOptions;
+use ibl_extract::{ExtractOptions, FitDomain};
 use ibl_light::Method;
 use ibl_pipeline::lights::{LightsOptions, lights};
 
@@ -27,6 +27,26 @@ pub enum MethodArg {
     VarianceMinimization,
     /// Irradiance optimisation (Madsen et al. 2003): lights fitted to the irradiance, any N.
     IrradianceOptimization,
+}
+
+/// What irradiance optimisation fits (`--fit-domain`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum FitDomainArg {
+    /// The lights above and below the horizon fitted apart, each to its hemisphere's
+    /// irradiance: a ground plane then shadows the probe's lower share only (for rendering).
+    Hemispheres,
+    /// One fit to the whole sphere's irradiance (the paper's; lowest unshadowed error).
+    Sphere,
+}
+
+impl FitDomainArg {
+    /// The library's choice.
+    pub fn domain(self) -> FitDomain {
+        match self {
+            FitDomainArg::Hemispheres => FitDomain::Hemispheres,
+            FitDomainArg::Sphere => FitDomain::Sphere,
+        }
+    }
 }
 
 impl MethodArg {
@@ -64,7 +84,8 @@ Examples:
   ibl lights probe.exr -n 12 --method adaptive-median-cut -o scene.xml -o scene.pbrt
   ibl lights probe.exr -n 8 --method lightgen --seed 7 -o sun.glb --lux-per-unit 20
   ibl lights probe.hdr -n 32 -o lights.json --frame blender --json
-  ibl lights sky.exr -n 1 --method irradiance-optimization --ambient-sh 3 -o sun+sh9.json"
+  ibl lights sky.exr -n 1 --method irradiance-optimization --ambient-sh 3 -o sun+sh9.json
+  ibl lights sky.exr -n 32 --method irradiance-optimization --fit-domain sphere -o paper.json"
 )]
 pub struct LightsArgs {
     /// The probe (.exr, .hdr, .pfm, .png, .jpg), lat-long or any mapping `--mapping` names.
@@ -81,6 +102,12 @@ pub struct LightsArgs {
     /// gives the same lights.
     #[arg(long, default_value_t = ExtractOptions::default().seed, value_name = "SEED")]
     pub seed: u64,
+    /// Irradiance optimisation only: fit the lights above and below the horizon apart
+    /// (`hemispheres`, so a ground plane shadows the right share, as `ibl render` does) or the
+    /// whole sphere at once (`sphere`, the paper's fit: 2 to 8 times lower unshadowed irradiance
+    /// error, as `ibl eval` scores it).
+    #[arg(long, value_enum, default_value = "hemispheres", value_name = "DOMAIN")]
+    pub fit_domain: FitDomainArg,
     /// Output file, format by extension: .json, .gltf, .glb, .xml (Mitsuba 3), .pbrt (pbrt-v4).
     /// Repeat to write several formats from one extraction.
     #[arg(short = 'o', long, value_name = "FILE")]
@@ -114,6 +141,7 @@ pub fn run(args: &LightsArgs) -> anyhow::Result<()> {
         count: args.count,
         method: args.method.method(),
         seed: args.seed,
+        fit_domain: args.fit_domain.domain(),
         outputs: args.output.clone(),
         frame: args.frame,
         lux_per_unit: args.lux_per_unit,

@@ -267,7 +267,7 @@ pub fn render_study(
             continue;
         }
         let started = Instant::now();
-        let options = ExtractOptions { seed: s.seed };
+        let options = ExtractOptions::for_rendering(s.seed);
         let (model, _) = build_model(&scene.probe.radiance, run.spec, run.n, &options)?;
         let seconds_extract = started.elapsed().as_secs_f64();
         let Some((lighting, mode, lights)) =

@@ -6,6 +6,7 @@
 
 pub mod adaptive_median_cut;
 mod cholesky;
+pub mod hemispheres;
 pub mod hybrid;
 pub mod irradiance_optimization;
 mod light_cells;
@@ -21,11 +22,12 @@ pub mod sun;
 pub mod variance_minimization;
 
 pub use adaptive_median_cut::adaptive_median_cut;
+pub use hemispheres::fit_hemispheres;
 pub use hybrid::Hybrid;
 pub use irradiance_optimization::{Fit, OptimizationOptions, irradiance_optimization};
 pub use lightgen::{LightGenOptions, lightgen};
 pub use median_cut::median_cut;
-pub use method::{ExtractOptions, extract};
+pub use method::{ExtractOptions, FitDomain, extract};
 pub use model::{Model, ModelSpec, build_model};
 pub use nnls::nnls_gram;
 pub use sun::{DominantLight, dominant_light};

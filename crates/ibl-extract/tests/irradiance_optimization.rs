@@ -13,7 +13,7 @@ use std::time::Instant;
 use ibl_core::glam::DVec3;
 use ibl_core::{Image, LatLong, Rgb, fibonacci_normals, irradiance_exact};
 use ibl_extract::irradiance_optimization::{FIT_NORMAL_COUNT, fit_irradiance, fit_normals};
-use ibl_extract::{OptimizationOptions, irradiance_optimization};
+use ibl_extract::{OptimizationOptions, fit_hemispheres, irradiance_optimization};
 use ibl_metrics::IrradianceError;
 
 fn probes() -> Vec<(String, Image<Rgb>)> {
@@ -118,6 +118,93 @@ fn each_fitted_light_is_sized_by_its_cell_of_the_probe() {
     }
 }
 
+/// `probe` with the rows of the other half black: the upper half (rows `0..h/2`) when `upper`.
+fn half(probe: &Image<Rgb>, upper: bool) -> Image<Rgb> {
+    let h = probe.height();
+    Image::from_fn_par(probe.width(), h, |i, j| {
+        if (j < h.div_ceil(2)) == upper {
+            *probe.get(i, j)
+        } else {
+            Rgb::ZERO
+        }
+    })
+}
+
+/// The irradiance of the lights on one side of the horizon (`y > 0` when `upper`) at `n`.
+fn side_irradiance(set: &ibl_light::LightSet, n: DVec3, upper: bool) -> [f64; 3] {
+    let mut e = [0.0; 3];
+    for l in set.lights.iter().filter(|l| (l.direction.y > 0.0) == upper) {
+        let c = n.dot(l.direction).max(0.0);
+        for ch in 0..3 {
+            e[ch] += l.irradiance[ch] * c;
+        }
+    }
+    e
+}
+
+#[test]
+fn fitted_apart_the_lights_carry_what_a_ground_lets_through() {
+    // A ground plane at the horizon passes the probe's upper hemisphere and stops the lower one:
+    // the irradiance a surface above it gets is the upper half's alone, E_up(n). Fitted to the
+    // whole sphere, a light may stand for light from both sides of the horizon, so the lights
+    // above it carry E_up badly; fitted apart (fit_hemispheres), the lights above the
+    // horizon carry E_up and those below carry E_down, each to the accuracy of a fit of that
+    // many lights. Apartment probe, 16 lights, scored on 20000 normals (measured: mean error of
+    // E_up 8.03 % whole-sphere, 1.83 % apart; E_down 8.92 % and 2.00 %). Bounds: apart below
+    // 3 %, whole-sphere above 6 %: a third or more of margin on each side, for another CPU's
+    // nearby local minimum (the golden test allows a fit 15 %).
+    let (_, apt) = probes()
+        .into_iter()
+        .find(|(n, _)| n == "apartment")
+        .unwrap();
+    let normals = fibonacci_normals(20_000);
+    let truth =
+        [true, false].map(|up| ibl_core::RowIrradiance::new(&half(&apt, up)).irradiance(&normals));
+    let o = OptimizationOptions::default();
+    let sphere = irradiance_optimization(&apt, 16, &o).unwrap();
+    let apart = fit_hemispheres(&apt, 16, &o).unwrap();
+    for (k, upper) in [true, false].into_iter().enumerate() {
+        let err = |fit: &ibl_extract::Fit| {
+            let approx: Vec<[f64; 3]> = normals
+                .iter()
+                .map(|&n| side_irradiance(&fit.set, n, upper))
+                .collect();
+            errors(&truth[k], &approx).0
+        };
+        let (whole, split) = (err(&sphere), err(&apart));
+        println!("upper {upper}: mean error whole sphere {whole:.2} %, apart {split:.2} %");
+        assert!(split < 3.0 && whole > 6.0, "{split} {whole}");
+    }
+    // The report says how the lights were shared: by the halves' powers (52 % above: 8 of 16),
+    // each half's lights on its side of the horizon.
+    assert_eq!(sphere.report.lights_above_horizon, None);
+    assert_eq!(apart.report.lights_above_horizon, Some(8));
+    let above = apart
+        .set
+        .lights
+        .iter()
+        .filter(|l| l.direction.y > 0.0)
+        .count();
+    assert_eq!(above, 8);
+    assert!(apart.report.converged);
+}
+
+#[test]
+fn hemispheres_of_one_light_or_one_lit_half_fit_as_one() {
+    // One light cannot be shared: the whole-sphere fit. A probe lit only above the horizon: all
+    // the lights go above, fitted to it whole (same lights as the sphere's fit of that half).
+    let o = OptimizationOptions::default();
+    let probe = Image::from_fn_par(64, 32, |i, j| {
+        Rgb::new(1.0 + (i % 5) as f32, 1.0, (j % 3) as f32)
+    });
+    let one = fit_hemispheres(&probe, 1, &o).unwrap();
+    assert_eq!(one.report.lights_above_horizon, None);
+    let upper = half(&probe, true);
+    let fit = fit_hemispheres(&upper, 6, &o).unwrap();
+    assert_eq!(fit.report.lights_above_horizon, Some(6));
+    assert!(fit.set.lights.iter().all(|l| l.direction.y > 0.0));
+}
+
 #[test]
 fn constant_environment_floor() {
     // E = pi L on every normal; N directional lights can only approximate the flat field with
@@ -151,7 +238,11 @@ fn bit_identical_whatever_the_thread_count() {
             .build()
             .unwrap()
             .install(|| {
-                irradiance_optimization(&probe, 9, &OptimizationOptions::default()).unwrap()
+                let o = OptimizationOptions::default();
+                [
+                    irradiance_optimization(&probe, 9, &o).unwrap(),
+                    fit_hemispheres(&probe, 9, &o).unwrap(),
+                ]
             })
     };
     assert_eq!(run(1), run(2));
@@ -162,6 +253,8 @@ fn bad_parameters_are_errors() {
     let probe = Image::filled(16, 8, Rgb::new(1.0, 1.0, 1.0));
     assert!(irradiance_optimization(&probe, 0, &OptimizationOptions::default()).is_err());
     assert!(irradiance_optimization(&probe, 5000, &OptimizationOptions::default()).is_err());
+    assert!(fit_hemispheres(&probe, 0, &OptimizationOptions::default()).is_err());
+    assert!(fit_hemispheres(&probe, 5000, &OptimizationOptions::default()).is_err());
     let empty = Image::filled(0, 0, Rgb::ZERO);
     assert!(irradiance_optimization(&empty, 4, &OptimizationOptions::default()).is_err());
     // A black probe: nothing to fit, zero lights, converged.

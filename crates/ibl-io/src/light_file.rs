@@ -278,6 +278,7 @@ mod tests {
                         fit_rms_err_pct: 1.5,
                         fit_mean_abs_err_pct: 1.0,
                         fit_normals: 6144,
+                        lights_above_horizon: Some(7),
                     }),
                     probe: Some(ProbeRef {
                         path: "p.exr".into(),

@@ -45,6 +45,12 @@ pub struct FitReport {
     pub fit_mean_abs_err_pct: f64,
     /// Number of fitting normals.
     pub fit_normals: usize,
+    /// Lights fitted to the upper hemisphere's irradiance when the fit took the hemispheres
+    /// apart (`ibl-extract`'s module `hemispheres`; the rest were fitted to the lower one), or
+    /// `None` for one fit over the whole sphere (the paper's). With two fits, `initial_cost` and
+    /// `final_cost` are the sums of the two fits' costs (each scaled by its own hemisphere's mean
+    /// irradiance); the error percentages are those of all the lights against the whole probe.
+    pub lights_above_horizon: Option<usize>,
 }
 
 /// An extraction method as it ran, with its parameters.
@@ -106,6 +112,9 @@ impl ParameterError {
 /// The method name of [`Extraction::ImportantPatches`].
 pub const IMPORTANT_PATCHES: &str = "important-patches";
 
+/// The parameter name of [`FitReport::lights_above_horizon`].
+const LIGHTS_ABOVE_HORIZON: &str = "lights_above_horizon";
+
 impl Extraction {
     /// The method's name in files (`median-cut`, ..., `sun`, or the unknown name as given).
     pub fn name(&self) -> &str {
@@ -153,16 +162,22 @@ impl Extraction {
             Extraction::LightGen { restarts, seed } => {
                 named(&[("restarts", *restarts as f64), ("seed", *seed as f64)])
             }
-            Extraction::IrradianceOptimization(r) => named(&[
-                ("iterations", r.iterations as f64),
-                ("total_iterations", r.total_iterations as f64),
-                ("converged", if r.converged { 1.0 } else { 0.0 }),
-                ("initial_cost", r.initial_cost),
-                ("final_cost", r.final_cost),
-                ("fit_rms_err_pct", r.fit_rms_err_pct),
-                ("fit_mean_abs_err_pct", r.fit_mean_abs_err_pct),
-                ("fit_normals", r.fit_normals as f64),
-            ]),
+            Extraction::IrradianceOptimization(r) => {
+                let mut p = named(&[
+                    ("iterations", r.iterations as f64),
+                    ("total_iterations", r.total_iterations as f64),
+                    ("converged", if r.converged { 1.0 } else { 0.0 }),
+                    ("initial_cost", r.initial_cost),
+                    ("final_cost", r.final_cost),
+                    ("fit_rms_err_pct", r.fit_rms_err_pct),
+                    ("fit_mean_abs_err_pct", r.fit_mean_abs_err_pct),
+                    ("fit_normals", r.fit_normals as f64),
+                ]);
+                if let Some(k) = r.lights_above_horizon {
+                    p.insert(LIGHTS_ABOVE_HORIZON.to_string(), k as f64);
+                }
+                p
+            }
             Extraction::AdaptiveMedianCut
             | Extraction::VarianceMinimization
             | Extraction::DominantLight
@@ -236,6 +251,12 @@ impl Extraction {
                     fit_rms_err_pct: number("fit_rms_err_pct")?,
                     fit_mean_abs_err_pct: number("fit_mean_abs_err_pct")?,
                     fit_normals: whole("fit_normals")? as usize,
+                    // Absent in files of one whole-sphere fit (and in files before the
+                    // hemispheres were fitted apart).
+                    lights_above_horizon: match parameters.get(LIGHTS_ABOVE_HORIZON) {
+                        Some(_) => Some(whole(LIGHTS_ABOVE_HORIZON)? as usize),
+                        None => None,
+                    },
                 })
             }
         })
@@ -284,6 +305,18 @@ mod tests {
                 fit_rms_err_pct: 1.5,
                 fit_mean_abs_err_pct: 1.25,
                 fit_normals: 4096,
+                lights_above_horizon: None,
+            }),
+            Extraction::IrradianceOptimization(FitReport {
+                iterations: 30,
+                total_iterations: 90,
+                converged: false,
+                initial_cost: 0.75,
+                final_cost: 0.25,
+                fit_rms_err_pct: 2.5,
+                fit_mean_abs_err_pct: 2.0,
+                fit_normals: 6144,
+                lights_above_horizon: Some(13),
             }),
             Extraction::DominantLight,
             Extraction::ImportantPatches { patches: 32 },
@@ -307,5 +340,10 @@ mod tests {
         assert_eq!(e.parameter, "splits");
         let half = BTreeMap::from([("splits".to_string(), 2.5)]);
         assert!(Extraction::from_parameters("median-cut", &half).is_err());
+        // A fit's parameters with a fractional light count above the horizon.
+        let mut fit = Extraction::IrradianceOptimization(FitReport::default()).parameters();
+        fit.insert(LIGHTS_ABOVE_HORIZON.to_string(), 1.5);
+        let e = Extraction::from_parameters("irradiance-optimization", &fit).unwrap_err();
+        assert_eq!(e.parameter, LIGHTS_ABOVE_HORIZON);
     }
 }

@@ -365,6 +365,7 @@ fn run_steps(
             count: l.n,
             method: t.method,
             seed: l.seed,
+            fit_domain: ibl_extract::FitDomain::Hemispheres,
             outputs: outputs.clone(),
             frame: FramePreset::Gltf,
             lux_per_unit: 1.0,

@@ -24,7 +24,7 @@ use ibl_eval::{
     ErrorChart, FigureFiles, PLOT_SIZE, PlotFiles, ProbeInput, Report, SphereField, SphereFigure,
     SweepOptions,
 };
-use ibl_extract::{ExtractOptions, ModelSpec};
+use ibl_extract::{ExtractOptions, FitDomain, ModelSpec};
 use ibl_light::Method;
 
 use crate::envmap_files::EnvMapping;
@@ -59,6 +59,8 @@ pub struct EvalSettings {
     pub figure_n: usize,
     /// Mapping of every probe (`None`: each detected from its shape).
     pub mapping: Option<EnvMapping>,
+    /// What irradiance optimisation fits (default: the hemispheres apart).
+    pub fit_domain: FitDomain,
 }
 
 impl EvalSettings {
@@ -106,6 +108,7 @@ impl EvalSettings {
             seed,
             figure_n,
             mapping: None,
+            fit_domain: FitDomain::default(),
         })
     }
 }
@@ -273,6 +276,7 @@ pub fn evaluate(
         normals: settings.normals,
         extract: ExtractOptions {
             seed: settings.seed,
+            fit_domain: settings.fit_domain,
         },
         keep_sets_at: Some(settings.figure_n),
     };

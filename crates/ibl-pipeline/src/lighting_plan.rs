@@ -96,7 +96,7 @@ impl LightingPlan {
         let set = match &self.given {
             Some(set) => set.clone(),
             None => {
-                let options = ExtractOptions { seed: self.seed };
+                let options = ExtractOptions::for_rendering(self.seed);
                 let spec = ModelSpec::Lights(self.source);
                 let (model, _) = build_model(&scene.probe.radiance, spec, self.lights, &options)
                     .context("extracting the lights")?;

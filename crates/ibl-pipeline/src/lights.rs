@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use ibl_core::FramePreset;
-use ibl_extract::ExtractOptions;
+use ibl_extract::{ExtractOptions, FitDomain};
 use ibl_io::LightFormat;
 use ibl_io::light_file::{AmbientRecord, LightsFile};
 use ibl_light::{LightSet, MAX_MEDIAN_CUT_SPLITS, Method, ProbeRef};
@@ -36,6 +36,8 @@ pub struct LightsOptions {
     pub method: Method,
     /// Seed of the methods' random choices.
     pub seed: u64,
+    /// What irradiance optimisation fits.
+    pub fit_domain: FitDomain,
     /// Light files, format by extension (`.json`, `.gltf`, `.glb`, `.xml`, `.pbrt`).
     pub outputs: Vec<PathBuf>,
     /// Frame preset of the written directions.
@@ -208,7 +210,10 @@ pub fn lights(o: &LightsOptions, progress: &dyn Progress) -> Result<LightsResult
             &env.image,
             method,
             o.count,
-            &ExtractOptions { seed: o.seed },
+            &ExtractOptions {
+                seed: o.seed,
+                fit_domain: o.fit_domain,
+            },
         )
     });
     let seconds = start.elapsed().as_secs_f64();

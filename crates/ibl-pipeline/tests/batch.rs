@@ -80,6 +80,7 @@ fn batch_files_equal_the_single_jobs_files() {
         count: 8,
         method: ibl_light::Method::LightGen,
         seed: 5,
+        fit_domain: ibl_extract::FitDomain::Hemispheres,
         outputs: vec![single.clone()],
         frame: ibl_core::FramePreset::Gltf,
         lux_per_unit: 1.0,

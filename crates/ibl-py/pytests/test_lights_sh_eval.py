@@ -128,3 +128,17 @@ def test_light_set_json_round_trips(tmp_path, sky):
     path = tmp_path / "l.json"
     path.write_text(text)
     np.testing.assert_allclose(iblkit.read_lights(path).directions, lights.directions, atol=1e-12)
+
+
+def test_fitted_lights_share_the_hemispheres_unless_asked_for_the_paper_fit(sky):
+    # Irradiance optimisation fits the lights above and below the horizon apart by default (as
+    # `ibl lights` does, for renders over a ground); fit_domain="sphere" is the paper's fit.
+    probe = iblkit.read_image(sky)
+    apart = iblkit.extract_lights(probe, 8, method="irradiance-optimization")
+    whole = iblkit.extract_lights(probe, 8, method="irradiance-optimization", fit_domain="sphere")
+    assert len(apart) == len(whole) == 8
+    # The sky probe holds 86 % of its power above the horizon: 7 of 8 lights go there.
+    assert int(np.sum(apart.directions[:, 1] > 0.0)) == 7
+    assert not np.allclose(apart.directions, whole.directions)
+    with pytest.raises(iblkit.BadInputError, match="fit domain"):
+        iblkit.extract_lights(probe, 8, method="irradiance-optimization", fit_domain="ground")

@@ -154,15 +154,18 @@ fn lights_file(set: &LightSet, frame: &str) -> PyResult<LightsFile> {
 
 /// Approximates a lat-long probe (H, W, 3) by `n` directional lights with `method`
 /// (median-cut, adaptive-median-cut, lightgen, variance-minimization, irradiance-optimization);
-/// `seed` drives the randomised methods. Median cut makes a power of two. Releases the GIL.
+/// `seed` drives the randomised methods; `fit_domain` is what irradiance optimisation fits
+/// (`hemispheres`: above and below the horizon apart, `sphere`: the paper's one fit). Median cut
+/// makes a power of two. Releases the GIL.
 #[pyfunction]
-#[pyo3(signature = (probe, n, method="median-cut", seed=None))]
+#[pyo3(signature = (probe, n, method="median-cut", seed=None, fit_domain="hemispheres"))]
 fn extract_lights(
     py: Python<'_>,
     probe: &Bound<'_, PyAny>,
     n: usize,
     method: &str,
     seed: Option<u64>,
+    fit_domain: &str,
 ) -> PyResult<PyLightSet> {
     let image = image_from(probe, "probe")?;
     let method: Method = method
@@ -170,6 +173,7 @@ fn extract_lights(
         .map_err(|e: ibl_light::MethodError| bad(e.to_string()))?;
     let options = ExtractOptions {
         seed: seed.unwrap_or(ExtractOptions::default().seed),
+        fit_domain: fit_domain.parse().map_err(lib)?,
     };
     let set = py
         .detach(|| ibl_extract::extract(&image, method, n, &options))
@@ -188,7 +192,7 @@ fn read_lights(path: PathBuf) -> PyResult<PyLightSet> {
 /// writes every output (`outputs`: light files by extension; `overlay`: a PNG), as the command
 /// does. Returns the light set.
 #[pyfunction]
-#[pyo3(signature = (probe, n, outputs, method="median-cut", seed=None, mapping=None, overlay=None, ambient_sh=None, progress=None))]
+#[pyo3(signature = (probe, n, outputs, method="median-cut", seed=None, mapping=None, overlay=None, ambient_sh=None, progress=None, fit_domain="hemispheres"))]
 #[allow(clippy::too_many_arguments)]
 fn lights_job(
     py: Python<'_>,
@@ -201,6 +205,7 @@ fn lights_job(
     overlay: Option<PathBuf>,
     ambient_sh: Option<usize>,
     progress: Option<Py<PyAny>>,
+    fit_domain: &str,
 ) -> PyResult<PyLightSet> {
     let options = ibl_pipeline::lights::LightsOptions {
         probe,
@@ -210,6 +215,7 @@ fn lights_job(
             .parse()
             .map_err(|e: ibl_light::MethodError| bad(e.to_string()))?,
         seed: seed.unwrap_or(ExtractOptions::default().seed),
+        fit_domain: fit_domain.parse().map_err(lib)?,
         outputs,
         frame: FramePreset::Gltf,
         lux_per_unit: 1.0,

@@ -223,7 +223,10 @@ fn settings(spp: u32, seed: u64) -> RenderSettings {
 /// extracted from the scene's probe with seed 1.
 fn lights_mode(scene: &Scene, method: &str, n: usize) -> (Lighting, LightSet) {
     let spec: ModelSpec = method.parse().unwrap();
-    let options = ExtractOptions { seed: 1 };
+    let options = ExtractOptions {
+        seed: 1,
+        ..Default::default()
+    };
     let (model, _) = build_model(&scene.probe.radiance, spec, n, &options).unwrap();
     let set = model.lights().cloned().unwrap();
     (

@@ -176,7 +176,7 @@ pub fn probe_overlay(request: &ProbeOverlayRequest) -> Result<ProbeOverlay, Stri
         probe,
         request.spec,
         request.lights,
-        &ExtractOptions::default(),
+        &ExtractOptions::for_rendering(ExtractOptions::default().seed),
     )
     .map_err(|e| e.to_string())?;
     let set = model

@@ -68,7 +68,11 @@ def names() -> Dict[str, List[str]]: ...
 
 # Lights (lights.rs)
 def extract_lights(
-    probe: npt.ArrayLike, n: int, method: str = "median-cut", seed: Optional[int] = None
+    probe: npt.ArrayLike,
+    n: int,
+    method: str = "median-cut",
+    seed: Optional[int] = None,
+    fit_domain: str = "hemispheres",
 ) -> LightSet: ...
 def read_lights(path: _Path) -> LightSet: ...
 def lights_job(
@@ -81,6 +85,7 @@ def lights_job(
     overlay: Optional[_Path] = None,
     ambient_sh: Optional[int] = None,
     progress: _Progress = None,
+    fit_domain: str = "hemispheres",
 ) -> LightSet: ...
 
 # Spherical harmonics (sh.rs)
