@@ -1,8 +1,8 @@
 //! Irradiance optimisation with the hemispheres apart: the lights above the horizon fitted to
 //! the upper hemisphere's irradiance, the lights below it to the lower one's.
 //!
-//! One fit to the whole sphere's irradiance (Madsen et al. 2003; module
-//! [`crate::irradiance_optimization`]) is free to put a light anywhere its cosine lobe helps the
+//! One fit to the whole sphere's irradiance (Madsen et al. 2003;
+//! [`crate::irradiance_optimization()`]) is free to put a light anywhere its cosine lobe helps the
 //! irradiance of unshadowed normals, and irradiance cannot tell light from just above the horizon
 //! from light just below it: a fitted light near the horizon may stand for both. A ground plane
 //! then shadows it whole, or not at all, where it should pass the probe's upper share and stop
@@ -37,7 +37,7 @@ use ibl_core::{Image, Rgb, RowIrradiance};
 use ibl_light::{Extraction, FitReport, Light, LightSet, Provenance};
 
 use crate::irradiance_optimization::{
-    Fit, MAX_LIGHTS, OptimizationOptions, fit_errors, fit_irradiance, fit_normals,
+    Fit, OptimizationOptions, check_light_count, fit_errors, fit_irradiance, fit_normals,
 };
 use crate::light_cells::size_by_cells;
 use crate::region_stats::Grid;
@@ -45,20 +45,17 @@ use crate::{ExtractError, irradiance_optimization};
 
 /// Irradiance optimisation of `probe` (lat-long, world frame) into exactly `n` lights (1 to
 /// [`MAX_LIGHTS`]) with the hemispheres fitted apart (module doc): [`FitDomain::Hemispheres`].
-/// One light, or a probe without power, is one whole-sphere fit ([`irradiance_optimization`]).
+/// One light, or a probe without power, is one whole-sphere fit ([`irradiance_optimization()`]).
 /// The report's `lights_above_horizon` says how the lights were shared.
 ///
 /// [`FitDomain::Hemispheres`]: crate::FitDomain::Hemispheres
+/// [`MAX_LIGHTS`]: crate::irradiance_optimization::MAX_LIGHTS
 pub fn fit_hemispheres(
     probe: &Image<Rgb>,
     n: usize,
     options: &OptimizationOptions,
 ) -> Result<Fit, ExtractError> {
-    if n == 0 || n > MAX_LIGHTS {
-        return Err(ExtractError::Parameter(format!(
-            "irradiance optimisation fits 1 to {MAX_LIGHTS} lights; got {n}"
-        )));
-    }
+    check_light_count(n)?;
     let grid = Grid::new(probe)?;
     let upper_rows = upper_rows(probe.height());
     let power = half_powers(probe, &grid, upper_rows);

@@ -197,6 +197,16 @@ const INSERT_CANDIDATES: usize = 256;
 /// Floor of a fitted power relative to the mean irradiance (keeps `log` finite).
 const POWER_FLOOR: f64 = 1e-9;
 
+/// Refuses a light count outside 1 to [`MAX_LIGHTS`].
+pub(crate) fn check_light_count(n: usize) -> Result<(), ExtractError> {
+    if n == 0 || n > MAX_LIGHTS {
+        return Err(ExtractError::Parameter(format!(
+            "irradiance optimisation fits 1 to {MAX_LIGHTS} lights; got {n}"
+        )));
+    }
+    Ok(())
+}
+
 /// Irradiance optimisation into exactly `n` lights (see the module doc).
 pub fn irradiance_optimization(
     probe: &Image<Rgb>,
@@ -206,11 +216,7 @@ pub fn irradiance_optimization(
     if probe.width() == 0 || probe.height() == 0 {
         return Err(ExtractError::Invalid("the probe has no pixels".into()));
     }
-    if n == 0 || n > MAX_LIGHTS {
-        return Err(ExtractError::Parameter(format!(
-            "irradiance optimisation fits 1 to {MAX_LIGHTS} lights; got {n}"
-        )));
-    }
+    check_light_count(n)?;
     let normals = fit_normals();
     let target = RowIrradiance::new(probe).irradiance(&normals);
     let mut fit = fit_irradiance(normals, target, n, options)?;
@@ -252,11 +258,7 @@ pub fn fit_irradiance(
     n: usize,
     options: &OptimizationOptions,
 ) -> Result<Fit, ExtractError> {
-    if n == 0 || n > MAX_LIGHTS {
-        return Err(ExtractError::Parameter(format!(
-            "irradiance optimisation fits 1 to {MAX_LIGHTS} lights; got {n}"
-        )));
-    }
+    check_light_count(n)?;
     if normals.len() != target.len() {
         return Err(ExtractError::Invalid(format!(
             "{} normals for {} irradiance values (need equal counts)",
