@@ -33,14 +33,13 @@
 //! (indoors) and 11.9x (outdoors) the floor; fitted apart, 2.3x and 2.5x, where median cut's are
 //! 15.3x and 4.0x (BENCHMARKS.md, "Irradiance optimisation with the hemispheres apart").
 
-use ibl_core::{Image, Rgb, RowIrradiance};
+use ibl_core::{Image, LatLong, Rgb, RowIrradiance};
 use ibl_light::{Extraction, FitReport, Light, LightSet, Provenance};
 
 use crate::irradiance_optimization::{
     Fit, OptimizationOptions, check_light_count, fit_errors, fit_irradiance, fit_normals,
 };
 use crate::light_cells::size_by_cells;
-use crate::region_stats::Grid;
 use crate::{ExtractError, irradiance_optimization};
 
 /// Irradiance optimisation of `probe` (lat-long, world frame) into exactly `n` lights (1 to
@@ -56,9 +55,8 @@ pub fn fit_hemispheres(
     options: &OptimizationOptions,
 ) -> Result<Fit, ExtractError> {
     check_light_count(n)?;
-    let grid = Grid::new(probe)?;
     let upper_rows = upper_rows(probe.height());
-    let power = half_powers(probe, &grid, upper_rows);
+    let power = half_powers(probe, upper_rows);
     let total = power[0] + power[1];
     if n < 2 || !(total.is_finite() && total > 0.0) {
         return irradiance_optimization(probe, n, options);
@@ -114,8 +112,9 @@ fn upper_rows(h: usize) -> usize {
 }
 
 /// Luminance power (sum of luminance times pixel solid angle; negative and non-finite values
-/// count as 0) of rows `0..upper` and of the rest.
-fn half_powers(probe: &Image<Rgb>, grid: &Grid, upper: usize) -> [f64; 2] {
+/// count as 0) of rows `0..upper` and of the rest. An image without pixels has none.
+fn half_powers(probe: &Image<Rgb>, upper: usize) -> [f64; 2] {
+    let grid = LatLong::new(probe.width(), probe.height());
     let mut power = [0.0; 2];
     for j in 0..probe.height() {
         let row: f64 = probe
@@ -124,7 +123,9 @@ fn half_powers(probe: &Image<Rgb>, grid: &Grid, upper: usize) -> [f64; 2] {
             .map(|p| f64::from(p.luminance()))
             .filter(|v| v.is_finite() && *v > 0.0)
             .sum();
-        power[usize::from(j >= upper)] += row * grid.row_sr[j];
+        if row > 0.0 {
+            power[usize::from(j >= upper)] += row * grid.row_solid_angle(j);
+        }
     }
     power
 }

@@ -257,6 +257,9 @@ fn bad_parameters_are_errors() {
     assert!(fit_hemispheres(&probe, 5000, &OptimizationOptions::default()).is_err());
     let empty = Image::filled(0, 0, Rgb::ZERO);
     assert!(irradiance_optimization(&empty, 4, &OptimizationOptions::default()).is_err());
+    assert!(fit_hemispheres(&empty, 4, &OptimizationOptions::default()).is_err());
+    let no_columns = Image::filled(0, 8, Rgb::ZERO);
+    assert!(fit_hemispheres(&no_columns, 4, &OptimizationOptions::default()).is_err());
     // A black probe: nothing to fit, zero lights, converged.
     let black = Image::filled(16, 8, Rgb::ZERO);
     let fit = irradiance_optimization(&black, 4, &OptimizationOptions::default()).unwrap();

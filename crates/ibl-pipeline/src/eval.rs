@@ -59,7 +59,7 @@ pub struct EvalSettings {
     pub figure_n: usize,
     /// Mapping of every probe (`None`: each detected from its shape).
     pub mapping: Option<EnvMapping>,
-    /// What irradiance optimisation fits (default: the hemispheres apart).
+    /// What irradiance optimisation fits (default: the whole sphere, the paper's fit).
     pub fit_domain: FitDomain,
 }
 
