@@ -61,8 +61,9 @@
 //! # The hemispheres apart
 //! A light near the horizon may stand, in irradiance, for light from both sides of it, and a
 //! ground plane then shadows it whole. [`crate::fit_hemispheres`] (what renders use) fits the
-//! lights above and below the horizon apart, each set to its half of the probe: 32 lights went from 42.5x to 2.3x the reference's noise floor indoors,
-//! at 2 to 8 times the whole-sphere fit's unshadowed irradiance error.
+//! lights above and below the horizon apart, each set to its half of the probe: 32 lights went
+//! from 42.5x to 2.3x the reference's noise floor indoors, at 2 to 8 times the whole-sphere
+//! fit's unshadowed irradiance error.
 //!
 //! # Cost
 //! The Jacobian has structure: with the light's features `c = n.w`, `a = n.t1`, `b = n.t2` (zero
