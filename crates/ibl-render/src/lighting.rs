@@ -27,6 +27,22 @@
 //! direction alike: near-black patches on the bunny. The vertex's light (lights plus ambient) is
 //! clamped at 0 per channel.
 //!
+//! **The ambient's two band counts.** The occlusion rays read the ambient in the scene's
+//! `ambient_bands` (5), but a surface nothing occludes gets its irradiance in
+//! [`MAX_AMBIENT_BANDS`] (16): the probe less the lights is carried on to 16 bands
+//! (`with_finer_bands`: the probe projected again, the lights taken off as points), and the
+//! irradiance of the bands above the rays' is tabulated over normals ([`NormalTable`]). So on an
+//! open surface lights plus ambient are the probe's irradiance but for the Lambert kernel's
+//! bands above 15, where N lights alone have content in every band (a point light's
+//! `max(0, n . w)`: bands 4, 6, 8 ... at `A_l / A_0` = 4 %, 1.6 %, 0.8 % ... of its power, which
+//! the 5-band ambient left in: on bunny-apartment's floor 16 LightGen lights plus the ambient
+//! were 0.7 to 1.1 % too dark). The rays keep the lower bands: a band-limited difference read
+//! over the part of the sphere an occluder hides rings, and more bands there lose more than they
+//! gain (bunny-apartment, LightGen's 16 lights plus ambient, converged, in multiples of the
+//! reference's noise floor: 3.74x with 5 bands for both, 3.41x with 9 for both, 2.25x with 16
+//! for the open surface and 5 for the rays; BENCHMARKS.md, "The hybrid's open surfaces in every
+//! band").
+//!
 //! **Goniometric lights** (Grosch 2005 section 4.2, new light sources): in every mode the
 //! lighting may also hold point lights with measured intensity distributions
 //! ([`Lighting::luminaires`], `ibl_light::GoniometricLight`, positioned in the world frame: a
@@ -45,10 +61,10 @@
 use std::f64::consts::TAU;
 
 use glam::{DMat3, DVec3, Vec3};
-use ibl_core::Rgb;
+use ibl_core::{Image, LatLong, Rgb};
 use ibl_light::{GoniometricLight, LightSet};
 use ibl_scene::{Scene, ShadowKind};
-use ibl_sh::{IrradianceSh, RadianceSh, Window, basis, eval_basis};
+use ibl_sh::{IrradianceSh, RadianceSh, Window, basis, eval_basis, project_latlong};
 
 use crate::environment::{EnvironmentError, EnvironmentLight};
 use crate::sampling::{OrthonormalBasis, UniformCone};
@@ -102,12 +118,15 @@ pub const MAX_AMBIENT_BANDS: usize = 16;
 /// The ambient of the `hybrid` mode: an SH radiance, world frame, seen through occlusion rays.
 #[derive(Clone, Debug)]
 pub struct Ambient {
-    /// The ambient radiance (probe units, world frame), cut to at most [`MAX_AMBIENT_BANDS`]
-    /// bands.
+    /// The ambient radiance the occlusion rays read (probe units, world frame), cut to at most
+    /// [`MAX_AMBIENT_BANDS`] bands.
     sh: RadianceSh,
-    /// Its irradiance (the Lambert convolution of `sh`, no window): what the ambient gives a
-    /// surface that nothing occludes.
+    /// Its irradiance (the Lambert convolution of `sh`, no window): with `finer`, what the
+    /// ambient gives a surface that nothing occludes.
     irradiance: IrradianceSh,
+    /// The irradiance of the ambient's bands above `sh`'s, where it has more
+    /// ([`Ambient::with_ray_bands`]), tabulated over normals.
+    finer: Option<NormalTable>,
     /// Occlusion rays per shading point, at least 1.
     pub occlusion_rays: u32,
 }
@@ -116,10 +135,30 @@ impl Ambient {
     /// The ambient of radiance `radiance` (world frame; its bands are cut to
     /// [`MAX_AMBIENT_BANDS`]) with `occlusion_rays` rays per shading point (at least 1).
     pub fn new(radiance: &RadianceSh, occlusion_rays: u32) -> Ambient {
-        let sh = radiance.truncated(MAX_AMBIENT_BANDS);
+        Ambient::with_ray_bands(radiance, MAX_AMBIENT_BANDS, occlusion_rays)
+    }
+
+    /// The ambient of radiance `radiance` (world frame, cut to [`MAX_AMBIENT_BANDS`]) whose
+    /// occlusion rays read only its first `ray_bands` bands (at least 1), while a surface
+    /// that nothing occludes gets the irradiance of all of them (the bands above `ray_bands`
+    /// tabulated over normals, [`NormalTable`]). See the module notes, "The ambient's two
+    /// band counts".
+    pub fn with_ray_bands(radiance: &RadianceSh, ray_bands: usize, occlusion_rays: u32) -> Ambient {
+        let full = radiance.truncated(MAX_AMBIENT_BANDS);
+        let sh = full.truncated(ray_bands);
+        let finer = (full.bands() > sh.bands())
+            .then(|| {
+                let mut high = full.coefficients().to_vec();
+                high[..sh.coefficients().len()].fill([0.0; 3]);
+                // Same count, finite values: cannot fail.
+                RadianceSh::new(full.bands(), high).ok()
+            })
+            .flatten()
+            .map(|high| NormalTable::new(&high.irradiance(Window::None)));
         Ambient {
             irradiance: sh.irradiance(Window::None),
             sh,
+            finer,
             occlusion_rays: occlusion_rays.max(1),
         }
     }
@@ -136,9 +175,68 @@ impl Ambient {
     }
 
     /// The ambient irradiance on an unoccluded surface of unit normal `n` (world frame; may be
-    /// negative), `int max(0, n . w) L_a(w) dw` (Ramamoorthi and Hanrahan 2001). O(bands^2).
+    /// negative), `int max(0, n . w) L_a(w) dw` (Ramamoorthi and Hanrahan 2001): the rays'
+    /// bands exactly, O(bands^2), plus the finer bands' table where there is one.
     pub fn irradiance(&self, n: Vec3) -> Rgb {
-        evaluate(self.irradiance.bands(), self.irradiance.coefficients(), n)
+        let low = evaluate(self.irradiance.bands(), self.irradiance.coefficients(), n);
+        match &self.finer {
+            Some(table) => low + table.at(n),
+            None => low,
+        }
+    }
+}
+
+/// An RGB function of the unit normal tabulated on a lat-long grid of normals
+/// ([`NormalTable::WIDTH`] x [`NormalTable::HEIGHT`], texel centres, CONVENTIONS section 2) and
+/// read bilinearly: the hybrid ambient's irradiance in its bands above the rays', which
+/// evaluated per shading point would cost O(16^2) terms (a hybrid render of bunny-apartment at
+/// 320 px took 27 % longer so; the table takes about 26 ms to fill on 2 cores). Those bands
+/// carry a small part of the irradiance (the Lambert kernel passes even band `l` at about
+/// `l^-2.5`, odd bands above 1 not at all), and the grid resolves the finest of them, band 14 (a
+/// 25.7-degree period), with 18 texels a period: a test measures the bilinear error at 0.5 % of
+/// that part's largest value.
+#[derive(Clone, Debug)]
+pub struct NormalTable {
+    texels: Vec<Rgb>,
+}
+
+impl NormalTable {
+    /// Columns of the grid.
+    pub const WIDTH: usize = 256;
+    /// Rows of the grid.
+    pub const HEIGHT: usize = 128;
+
+    /// The table of `irradiance` at every texel's centre direction.
+    pub fn new(irradiance: &IrradianceSh) -> NormalTable {
+        let grid = LatLong::new(Self::WIDTH, Self::HEIGHT);
+        let dirs: Vec<DVec3> = (0..Self::HEIGHT)
+            .flat_map(|j| (0..Self::WIDTH).map(move |i| grid.pixel_dir64(i, j)))
+            .collect();
+        let texels = irradiance
+            .eval_many(&dirs)
+            .into_iter()
+            .map(|[r, g, b]| Rgb::new(r as f32, g as f32, b as f32))
+            .collect();
+        NormalTable { texels }
+    }
+
+    /// The tabulated value at the unit normal `n`, bilinear between the four nearest texel
+    /// centres (columns wrap, rows clamp at the poles).
+    pub fn at(&self, n: Vec3) -> Rgb {
+        let (u, v) = LatLong::dir_to_uv(n.as_dvec3());
+        let (w, h) = (Self::WIDTH, Self::HEIGHT);
+        let x = u * w as f64 - 0.5;
+        let y = (v * h as f64 - 0.5).clamp(0.0, (h - 1) as f64);
+        let (x0, y0) = (x.floor(), y.floor());
+        let (tx, ty) = ((x - x0) as f32, (y - y0) as f32);
+        let i0 = (x0 as i64).rem_euclid(w as i64) as usize;
+        let i1 = (i0 + 1) % w;
+        let j0 = (y0 as usize).min(h - 1);
+        let j1 = (j0 + 1).min(h - 1);
+        let t = |i: usize, j: usize| self.texels[j * w + i];
+        let top = t(i0, j0) * (1.0 - tx) + t(i1, j0) * tx;
+        let bottom = t(i0, j1) * (1.0 - tx) + t(i1, j1) * tx;
+        top * (1.0 - ty) + bottom * ty
     }
 }
 
@@ -215,7 +313,10 @@ impl Lighting {
 
     /// `hybrid` mode: the lights `set` and the `ambient` radiance (the probe minus the lights as
     /// point sources, as `ibl_extract::Hybrid` makes it) are in the probe's frame; with soft
-    /// shadows the ambient gives back what the cones spread (see the module notes).
+    /// shadows the ambient gives back what the cones spread (see the module notes). The
+    /// occlusion rays read `ambient`'s bands; an open surface gets the ambient carried on to
+    /// [`MAX_AMBIENT_BANDS`] (module notes, "The ambient's two band counts"): a projection of
+    /// the scene's probe, O(W H) for a W x H probe, about 15 ms at 512 x 256.
     pub fn hybrid(
         scene: &Scene,
         set: &LightSet,
@@ -224,15 +325,17 @@ impl Lighting {
         occlusion_rays: u32,
     ) -> Result<Lighting, EnvironmentError> {
         let rotation = scene.probe.world_from_probe.as_dmat3();
-        let ambient = match shadows {
-            ShadowKind::Hard => ambient.clone(),
-            ShadowKind::Soft => with_cones_spread(ambient, set),
+        let ray_bands = ambient.bands();
+        let full = with_finer_bands(&scene.probe.radiance, set, ambient);
+        let full = match shadows {
+            ShadowKind::Hard => full,
+            ShadowKind::Soft => with_cones_spread(&full, set),
         };
         Ok(Lighting {
             environment: Self::environment(scene)?,
             illumination: Illumination::Hybrid(
                 light_list(scene, set, shadows),
-                Ambient::new(&ambient.rotated(rotation), occlusion_rays),
+                Ambient::with_ray_bands(&full.rotated(rotation), ray_bands, occlusion_rays),
             ),
             luminaires: scene.luminaires.clone(),
         })
@@ -243,6 +346,32 @@ impl Lighting {
         self.luminaires.extend(luminaires);
         self
     }
+}
+
+/// The ambient `ambient` (probe frame: the probe less the lights `lights` as points, in its
+/// bands) carried on to [`MAX_AMBIENT_BANDS`] bands: the probe's projection less the same
+/// points in the bands above `ambient`'s, `ambient`'s own coefficients below. `ambient` itself
+/// where it has them all, or where the probe cannot be projected. O(W H 16^2) for a W x H
+/// probe.
+fn with_finer_bands(probe: &Image<Rgb>, lights: &LightSet, ambient: &RadianceSh) -> RadianceSh {
+    let bands = MAX_AMBIENT_BANDS;
+    if ambient.bands() >= bands {
+        return ambient.clone();
+    }
+    let Ok(projected) = project_latlong(probe, bands) else {
+        return ambient.clone();
+    };
+    let mut coefficients = projected.coefficients().to_vec();
+    for light in &lights.lights {
+        let y = basis(light.direction, bands);
+        for (c, yk) in coefficients.iter_mut().zip(&y) {
+            for (v, power) in c.iter_mut().zip(light.irradiance.to_array()) {
+                *v -= power * yk;
+            }
+        }
+    }
+    coefficients[..ambient.coefficients().len()].copy_from_slice(ambient.coefficients());
+    RadianceSh::new(bands, coefficients).unwrap_or_else(|_| ambient.clone())
 }
 
 /// `ambient + sum_i I_i (1 - g_l(c_i)) Y_lm(w_i)`: a point-subtracted ambient turned into the
@@ -344,5 +473,92 @@ impl LightList {
             })
             .collect();
         LightList { lights, shadows }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)] // tests may panic
+
+    use super::*;
+
+    /// The irradiance of a radiance with coefficients of one size in every band from 5 to 15
+    /// (pseudo-random signs and sizes), the rest zero: the part of a hybrid's ambient the
+    /// table holds, with far more in its finest bands than a probe has.
+    fn high_bands_irradiance() -> IrradianceSh {
+        let bands = MAX_AMBIENT_BANDS;
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let coefficients = (0..bands * bands)
+            .map(|k| {
+                if k < 25 {
+                    return [0.0; 3];
+                }
+                [0.0; 3].map(|_| {
+                    state ^= state << 13;
+                    state ^= state >> 7;
+                    state ^= state << 17;
+                    (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+                })
+            })
+            .collect();
+        RadianceSh::new(bands, coefficients)
+            .unwrap()
+            .irradiance(Window::None)
+    }
+
+    #[test]
+    fn the_normal_table_reads_the_irradiance_within_its_bilinear_bound() {
+        // Bands 5 to 15 on a 256 x 128 grid: the finest even band (14, a 25.7-degree period)
+        // has 18 texels a period, where linear interpolation errs by at most `(pi / 18)^2 / 2`
+        // = 1.5 % of that band's amplitude; the coarser bands, which the Lambert kernel passes
+        // far more of, much less. Measured: 0.51 % of the largest value over 5000 normals (2.0 %
+        // on a 128 x 64 grid). Tolerance 1 %; the part the table holds is itself a few per cent
+        // of an ambient's irradiance.
+        let sh = high_bands_irradiance();
+        let table = NormalTable::new(&sh);
+        let normals = ibl_core::fibonacci_normals(5000);
+        let exact: Vec<[f64; 3]> = sh.eval_many(&normals);
+        let largest = exact
+            .iter()
+            .flat_map(|e| e.iter().map(|v| v.abs()))
+            .fold(0.0, f64::max);
+        let worst = normals
+            .iter()
+            .zip(&exact)
+            .map(|(n, e)| {
+                let t = table.at(n.as_vec3());
+                (f64::from(t.r) - e[0])
+                    .abs()
+                    .max((f64::from(t.g) - e[1]).abs())
+                    .max((f64::from(t.b) - e[2]).abs())
+            })
+            .fold(0.0, f64::max);
+        assert!(
+            worst < 0.01 * largest,
+            "worst {worst:.3e}, largest {largest:.3e}"
+        );
+    }
+
+    #[test]
+    fn an_ambient_with_fewer_ray_bands_keeps_its_irradiance_and_cuts_its_rays() {
+        // The rays read the first `ray_bands` bands exactly; an open surface gets every band,
+        // within the table's bound (above) on the bands above the rays'.
+        let mut coefficients = high_bands_irradiance().coefficients().to_vec();
+        coefficients[0] = [2.0, 1.5, 1.0];
+        coefficients[2] = [0.5, 0.4, 0.3];
+        let radiance = RadianceSh::new(MAX_AMBIENT_BANDS, coefficients).unwrap();
+        let split = Ambient::with_ray_bands(&radiance, 5, 4);
+        let whole = Ambient::new(&radiance, 4);
+        let five = Ambient::new(&radiance.truncated(5), 4);
+        for n in ibl_core::fibonacci_normals(300) {
+            let n = n.as_vec3();
+            assert_eq!(split.radiance(n), five.radiance(n));
+            let (a, b) = (split.irradiance(n), whole.irradiance(n));
+            assert!(
+                (a.r - b.r).abs() < 0.02 && (a.g - b.g).abs() < 0.02,
+                "{a:?} {b:?}"
+            );
+        }
+        assert_eq!(split.radiance_sh().bands(), 5);
     }
 }

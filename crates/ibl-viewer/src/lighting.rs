@@ -87,10 +87,7 @@ pub fn scene_lighting(request: &SceneLightingRequest) -> Result<SceneLighting, S
     let set = set.ok_or_else(|| "the reference mode has no lights to draw".to_string())?;
     let (list, ambient) = match &lighting.illumination {
         Illumination::Lights(list) => (list, None),
-        Illumination::Hybrid(list, ambient) => (
-            list,
-            Some(ambient.radiance_sh().irradiance(ibl_sh::Window::None)),
-        ),
+        Illumination::Hybrid(list, ambient) => (list, Some(ambient)),
         Illumination::Environment => return Err("the reference mode has no lights".into()),
     };
     if list.lights.len() > crate::gpu_scene::MAX_SHADOWED_LIGHTS {
@@ -107,8 +104,9 @@ pub fn scene_lighting(request: &SceneLightingRequest) -> Result<SceneLighting, S
         list.lights.len(),
         set.provenance.extraction.name()
     );
-    if let Some(sh) = &ambient {
-        summary += &format!(" + SH{} ambient", sh.bands() * sh.bands());
+    if let Some(ambient) = &ambient {
+        let bands = ambient.radiance_sh().bands();
+        summary += &format!(" + SH{} ambient", bands * bands);
     }
     match lighting.luminaires.len() {
         0 => {}
@@ -121,18 +119,29 @@ pub fn scene_lighting(request: &SceneLightingRequest) -> Result<SceneLighting, S
         luminaire_role: PointLightRole::NEW,
         luminaire_near_field_m2: Vec::new(),
         occlusion_gather: false,
-        ambient: ambient
-            .as_ref()
-            .map(|sh| irradiance_map(sh, IRRADIANCE_MAP_WIDTH)),
+        // The open surface's irradiance in every band the CPU renderer gives it
+        // (`ibl_render::lighting::Ambient::irradiance`), not only the rays' bands.
+        ambient: ambient.map(|a| {
+            map_of_normals(IRRADIANCE_MAP_WIDTH, |n| {
+                let e = a.irradiance(n.as_vec3());
+                [e.r, e.g, e.b].map(f64::from)
+            })
+        }),
         summary: format!("{summary}, {} shadows", plan.shadows.name()),
     })
 }
 
 /// `E(n)` of `sh` at the centre of every texel of a `width x width/2` lat-long grid, world frame.
 pub fn irradiance_map(sh: &IrradianceSh, width: usize) -> Image<Rgb> {
+    map_of_normals(width, |n| sh.irradiance(n))
+}
+
+/// `irradiance(n)` (RGB, clamped at 0) at the centre of every texel of a `width x width/2`
+/// lat-long grid of world-frame normals.
+fn map_of_normals(width: usize, irradiance: impl Fn(DVec3) -> [f64; 3] + Sync) -> Image<Rgb> {
     let grid = LatLong::new(width, width / 2);
     Image::from_fn_par(width, width / 2, |i, j| {
-        let e = sh.irradiance(grid.pixel_dir64(i, j));
+        let e = irradiance(grid.pixel_dir64(i, j));
         Rgb::new(
             e[0].max(0.0) as f32,
             e[1].max(0.0) as f32,

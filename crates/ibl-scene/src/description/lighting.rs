@@ -44,9 +44,10 @@ pub struct LightingDescription {
     /// Default 0.02, in `(0, 1]`.
     #[serde(default = "default_adaptive_contrast")]
     pub adaptive_contrast: f32,
-    /// SH bands of the hybrid ambient. Default 5: the ambient's bands 3 and 4 carry the
-    /// lights' own high-band error, which 3 bands leave in every unshadowed surface
-    /// (docs/RENDERING.md, "The hybrid's bands").
+    /// SH bands of the hybrid ambient that its occlusion rays read (a surface nothing occludes
+    /// gets 16). Default 5: the rays' bands 3 and 4 carry the lights' own error where an
+    /// occluder hides part of the sky (docs/RENDERING.md, "The hybrid's bands" and "The
+    /// ambient's two band counts").
     #[serde(default = "default_bands")]
     pub ambient_bands: u32,
     /// Occlusion rays per shading point and sample (hybrid). Default 4.
