@@ -20,7 +20,7 @@
 use ibl_core::glam::DVec3;
 use ibl_core::{Image, Rgb};
 use ibl_light::LightSet;
-use ibl_sh::{IrradianceSh, RadianceSh, Window, basis, project_latlong};
+use ibl_sh::{IrradianceSh, RadianceSh, Window, project_latlong, subtract_point_sources};
 use rayon::prelude::*;
 
 use crate::ExtractError;
@@ -46,14 +46,14 @@ impl Hybrid {
     ) -> Result<Hybrid, ExtractError> {
         let bands = probe_sh.bands();
         let mut coeffs = probe_sh.coefficients().to_vec();
-        for light in &lights.lights {
-            let y = basis(light.direction, bands);
-            for (c, yk) in coeffs.iter_mut().zip(&y) {
-                for (v, power) in c.iter_mut().zip(light.irradiance.to_array()) {
-                    *v -= power * yk;
-                }
-            }
-        }
+        subtract_point_sources(
+            &mut coeffs,
+            bands,
+            lights
+                .lights
+                .iter()
+                .map(|l| (l.direction, l.irradiance.to_array())),
+        );
         let ambient = RadianceSh::new(bands, coeffs)
             .map_err(|e| ExtractError::Invalid(format!("hybrid ambient: {e}")))?;
         let ambient_irradiance = ambient.irradiance(window);

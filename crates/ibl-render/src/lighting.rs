@@ -64,7 +64,9 @@ use glam::{DMat3, DVec3, Vec3};
 use ibl_core::{Image, LatLong, Rgb};
 use ibl_light::{GoniometricLight, LightSet};
 use ibl_scene::{Scene, ShadowKind};
-use ibl_sh::{IrradianceSh, RadianceSh, Window, basis, eval_basis, project_latlong};
+use ibl_sh::{
+    IrradianceSh, RadianceSh, Window, basis, eval_basis, project_latlong, subtract_point_sources,
+};
 
 use crate::environment::{EnvironmentError, EnvironmentLight};
 use crate::sampling::{OrthonormalBasis, UniformCone};
@@ -362,14 +364,14 @@ fn with_finer_bands(probe: &Image<Rgb>, lights: &LightSet, ambient: &RadianceSh)
         return ambient.clone();
     };
     let mut coefficients = projected.coefficients().to_vec();
-    for light in &lights.lights {
-        let y = basis(light.direction, bands);
-        for (c, yk) in coefficients.iter_mut().zip(&y) {
-            for (v, power) in c.iter_mut().zip(light.irradiance.to_array()) {
-                *v -= power * yk;
-            }
-        }
-    }
+    subtract_point_sources(
+        &mut coefficients,
+        bands,
+        lights
+            .lights
+            .iter()
+            .map(|l| (l.direction, l.irradiance.to_array())),
+    );
     coefficients[..ambient.coefficients().len()].copy_from_slice(ambient.coefficients());
     RadianceSh::new(bands, coefficients).unwrap_or_else(|_| ambient.clone())
 }

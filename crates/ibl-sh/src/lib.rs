@@ -15,7 +15,7 @@ pub mod volume;
 pub use basis::{MAX_BANDS, basis, coefficient_count, eval_basis, sh_index};
 pub use coefficients::{IrradianceSh, RadianceSh};
 pub use convolution::{Window, lambert_factor};
-pub use projection::project_latlong;
+pub use projection::{project_latlong, subtract_point_sources};
 pub use rotation::ShRotation;
 pub use volume::{
     IrradianceL2, IrradianceVolume, KeyPointIrradiance, KeyPointVolume, LeakControl, VolumeGrid,

@@ -23,10 +23,29 @@ use ibl_core::{Image, Rgb, valid_radiance};
 use rayon::prelude::*;
 
 use crate::ShError;
-use crate::basis::{MAX_BANDS, coefficient_count, eval_basis, sh_index};
+use crate::basis::{MAX_BANDS, basis, coefficient_count, eval_basis, sh_index};
 use crate::coefficients::RadianceSh;
 use crate::quadrature::gauss_legendre;
 use crate::rotation::ShRotation;
+
+/// Takes point sources off the radiance coefficients `coefficients` of `bands` bands (in the
+/// order of [`sh_index`]): a source of unit direction `d` and power `I` (per channel, radiance x
+/// sr) projects to `I Y_lm(d)`, which is subtracted. What is left of a probe once its lights
+/// are taken out as points (the hybrid's ambient). O(K bands^2) for K sources.
+pub fn subtract_point_sources(
+    coefficients: &mut [[f64; 3]],
+    bands: usize,
+    sources: impl IntoIterator<Item = (DVec3, [f64; 3])>,
+) {
+    for (direction, power) in sources {
+        let y = basis(direction, bands);
+        for (c, yk) in coefficients.iter_mut().zip(&y) {
+            for (v, p) in c.iter_mut().zip(power) {
+                *v -= p * yk;
+            }
+        }
+    }
+}
 
 /// Projects a lat-long probe (world frame) onto `bands` bands (1 to [`MAX_BANDS`]).
 pub fn project_latlong(probe: &Image<Rgb>, bands: usize) -> Result<RadianceSh, ShError> {
