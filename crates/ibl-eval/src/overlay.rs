@@ -192,6 +192,7 @@ mod tests {
             region,
             spread_sr: None,
             core_fraction: None,
+            side: None,
         }
     }
 

@@ -155,6 +155,8 @@ struct Problem {
     /// Target irradiance per channel (padded like `lanes`).
     target: ChannelValues,
     inv_mu: [f64; 3],
+    /// Where the lights may go.
+    domain: LightDomain,
 }
 
 /// Lights being fitted: unit directions and log powers (`I = exp(s)`); a channel the probe does
@@ -232,7 +234,7 @@ pub fn irradiance_optimization(
 /// channel scaled by its mean target irradiance. For light sets not fitted in one piece
 /// (module `hemispheres`).
 pub(crate) fn fit_errors(normals: Vec<DVec3>, target: &[[f64; 3]], lights: &[Light]) -> (f64, f64) {
-    let problem = Problem::new(normals, target);
+    let problem = Problem::new(normals, target, LightDomain::Sphere);
     let lights = Lights {
         dirs: lights.iter().map(|l| l.direction).collect(),
         log_power: lights
@@ -243,6 +245,41 @@ pub(crate) fn fit_errors(normals: Vec<DVec3>, target: &[[f64; 3]], lights: &[Lig
     let (_, cost) = problem.residuals(&lights);
     let rms = 100.0 * (2.0 * cost / (3 * problem.normals.len()) as f64).sqrt();
     (rms, problem.mean_abs_err_pct(&lights))
+}
+
+/// Where a fit may put its lights' directions (world frame, +Y up).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LightDomain {
+    /// Anywhere on the sphere (the paper's fit).
+    Sphere,
+    /// On or above the horizon (`y >= 0`): the lights of the upper half's fit
+    /// ([`crate::fit_hemispheres`]).
+    Above,
+    /// On or below the horizon (`y <= 0`): the lights of the lower half's fit.
+    Below,
+}
+
+impl LightDomain {
+    /// `w` (unit) projected into the domain: a direction on the wrong side of the horizon is
+    /// moved to the horizon at its own azimuth. A direction straight up or down that has no
+    /// azimuth on the wrong side gives `None`.
+    fn bound(self, w: DVec3) -> Option<DVec3> {
+        let y = match self {
+            LightDomain::Sphere => return Some(w),
+            LightDomain::Above => w.y.max(0.0),
+            LightDomain::Below => w.y.min(0.0),
+        };
+        DVec3::new(w.x, y, w.z).try_normalize()
+    }
+
+    /// Whether `w` lies in the domain.
+    fn contains(self, w: DVec3) -> bool {
+        match self {
+            LightDomain::Sphere => true,
+            LightDomain::Above => w.y >= 0.0,
+            LightDomain::Below => w.y <= 0.0,
+        }
+    }
 }
 
 /// Fits `n` lights to the irradiance `target` given on `normals` (unit, world frame), by
@@ -259,6 +296,22 @@ pub fn fit_irradiance(
     n: usize,
     options: &OptimizationOptions,
 ) -> Result<Fit, ExtractError> {
+    fit_irradiance_in(normals, target, n, options, LightDomain::Sphere)
+}
+
+/// [`fit_irradiance`] with every light kept in `domain` throughout the fit: each step, split and
+/// insertion that would take a light across the horizon puts it on the horizon instead
+/// (a projected Levenberg-Marquardt step; the trust test still only keeps steps that lower the
+/// cost). The halves of [`crate::fit_hemispheres`] are fitted so: a light of the upper half's fit
+/// that drifted below the horizon would be shadowed whole by a ground plane, and one of the lower
+/// half's that drifted above would light what the ground hides.
+pub fn fit_irradiance_in(
+    normals: Vec<DVec3>,
+    target: Vec<[f64; 3]>,
+    n: usize,
+    options: &OptimizationOptions,
+    domain: LightDomain,
+) -> Result<Fit, ExtractError> {
     check_light_count(n)?;
     if normals.len() != target.len() {
         return Err(ExtractError::Invalid(format!(
@@ -272,7 +325,7 @@ pub fn fit_irradiance(
             "the fitting normals must cover the sphere evenly: {problem}"
         )));
     }
-    let problem = Problem::new(normals, &target);
+    let problem = Problem::new(normals, &target, domain);
     if problem.inv_mu.iter().all(|&v| v == 0.0) {
         return Ok(black_fit(n, problem.normals.len()));
     }
@@ -299,7 +352,7 @@ pub fn fit_irradiance(
             for grow in [Growth::Split, Growth::Insert] {
                 let mut candidate = lights.clone();
                 match grow {
-                    Growth::Split => split_strongest(&mut candidate, level),
+                    Growth::Split => split_strongest(&mut candidate, level, domain),
                     Growth::Insert => problem.insert_at_deficits(&mut candidate, level),
                 }
                 let outcome = problem.refit(&mut candidate, options.level_iterations, options);
@@ -426,6 +479,7 @@ fn black_fit(n: usize, normals: usize) -> Fit {
             region: None,
             spread_sr: None,
             core_fraction: None,
+            side: None,
         })
         .collect();
     let report = FitReport {
@@ -460,15 +514,16 @@ fn without_weak_lights(lights: &Lights) -> Option<Lights> {
 
 /// Splits the strongest lights (by luminance power) until there are `count`: each becomes two
 /// lights of half its power, a small angle apart along its first tangent.
-fn split_strongest(lights: &mut Lights, count: usize) {
+fn split_strongest(lights: &mut Lights, count: usize, domain: LightDomain) {
     let mut order: Vec<usize> = (0..lights.len()).collect();
     order.sort_by(|&a, &b| luminance(lights.power(b)).total_cmp(&luminance(lights.power(a))));
     let spread = 0.25 * (4.0 * std::f64::consts::PI / count as f64).sqrt();
     for &i in order.iter().take(count - lights.len()) {
         let (t1, _) = tangents(lights.dirs[i]);
         let w = lights.dirs[i];
-        lights.dirs[i] = (w + spread * t1).normalize();
-        lights.dirs.push((w - spread * t1).normalize());
+        let apart = |d: DVec3| domain.bound(d.normalize()).unwrap_or(w);
+        lights.dirs[i] = apart(w + spread * t1);
+        lights.dirs.push(apart(w - spread * t1));
         let half = lights.log_power[i].map(|s| s - std::f64::consts::LN_2);
         lights.log_power[i] = half;
         lights.log_power.push(half);
@@ -503,7 +558,7 @@ struct Outcome {
 impl Problem {
     /// The problem of fitting `target` on `normals` (equal counts), each channel scaled by its
     /// mean.
-    fn new(normals: Vec<DVec3>, target: &[[f64; 3]]) -> Problem {
+    fn new(normals: Vec<DVec3>, target: &[[f64; 3]], domain: LightDomain) -> Problem {
         let inv_mu = channel_means(target).map(|m| {
             if m.is_finite() && m > 0.0 {
                 1.0 / m
@@ -517,6 +572,7 @@ impl Problem {
             normals,
             lanes,
             inv_mu,
+            domain,
         }
     }
 
@@ -540,9 +596,14 @@ impl Problem {
                 .map(|c| self.target[c][k] * self.inv_mu[c])
                 .sum::<f64>()
         };
+        let home = match self.domain {
+            LightDomain::Below => DVec3::NEG_Y,
+            _ => DVec3::Y,
+        };
         (0..self.normals.len())
+            .filter(|&k| self.domain.contains(self.normals[k]))
             .max_by(|&a, &b| score(a).total_cmp(&score(b)))
-            .map_or(DVec3::Y, |k| self.normals[k])
+            .map_or(home, |k| self.normals[k])
     }
 
     /// Adds lights until there are `count`, one at a time, each where it removes the most
@@ -557,7 +618,13 @@ impl Problem {
         let (r, _) = self.residuals(lights);
         let deficit: ChannelValues = r.map(|v| v.into_iter().map(|x| -x).collect());
         let step = (self.normals.len() / INSERT_CANDIDATES).max(1);
-        let candidates: Vec<DVec3> = self.normals.iter().step_by(step).copied().collect();
+        let candidates: Vec<DVec3> = self
+            .normals
+            .iter()
+            .step_by(step)
+            .copied()
+            .filter(|&w| self.domain.contains(w))
+            .collect();
         let mut sums: Vec<([f64; 3], f64)> = candidates
             .par_iter()
             .map(|w| self.lanes.pursuit_sums(*w, &deficit))
@@ -654,9 +721,11 @@ impl Problem {
             if round == 2 || !dead.iter().any(|&d| d) {
                 break;
             }
-            // Re-aim dead lights at the worst deficits (largest target minus fit, scaled).
+            // Re-aim dead lights at the worst deficits (largest target minus fit, scaled) among
+            // the normals in the domain.
             let (r, _) = self.residuals(lights);
             let mut deficit: Vec<(usize, f64)> = (0..self.normals.len())
+                .filter(|&k| self.domain.contains(self.normals[k]))
                 .map(|k| (k, -(r[0][k] + r[1][k] + r[2][k])))
                 .collect();
             deficit.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
@@ -757,6 +826,7 @@ impl Problem {
                     irradiance: Rgb64::from_array(irradiance),
                     spread_sr: None,
                     core_fraction: None,
+                    side: None,
                     region: None,
                 }
             })
@@ -772,7 +842,7 @@ impl Problem {
 
 /// `X^T X` for a tall column-major matrix: its lower triangle by blocks of [`GRAM_BLOCK`] columns
 /// (one matrix product each, in parallel), mirrored to the upper. O(M N^2 / 2).
-fn gram(x: &DMatrix<f64>) -> DMatrix<f64> {
+pub(crate) fn gram(x: &DMatrix<f64>) -> DMatrix<f64> {
     let (m, n) = x.shape();
     let mut q = DMatrix::zeros(n, n);
     if n == 0 || m == 0 {
@@ -845,7 +915,7 @@ fn levenberg_marquardt(
                 nu *= 2.0;
                 continue;
             };
-            let trial = apply_step(lights, &delta);
+            let trial = apply_step(lights, &delta, problem.domain);
             let (tr, tcost) = problem.residuals(&trial);
             // Predicted reduction of the quadratic model: -g.d - 1/2 d.H.d (H's lower triangle).
             hd.sygemv(1.0, &h, &delta, 0.0);
@@ -892,13 +962,16 @@ fn levenberg_marquardt(
 
 /// The lights after a parameter step `delta` (`u, v, s_r, s_g, s_b` per light); log-power steps
 /// are limited to +-4 (a factor of 55) per iteration.
-fn apply_step(lights: &Lights, delta: &DVector<f64>) -> Lights {
+fn apply_step(lights: &Lights, delta: &DVector<f64>, domain: LightDomain) -> Lights {
     let mut out = lights.clone();
     for i in 0..lights.len() {
         let w = lights.dirs[i];
         let (t1, t2) = tangents(w);
         let moved = w + delta[5 * i] * t1 + delta[5 * i + 1] * t2;
-        out.dirs[i] = moved.try_normalize().unwrap_or(w);
+        out.dirs[i] = moved
+            .try_normalize()
+            .and_then(|m| domain.bound(m))
+            .unwrap_or(w);
         for c in 0..3 {
             out.log_power[i][c] += delta[5 * i + 2 + c].clamp(-4.0, 4.0);
         }

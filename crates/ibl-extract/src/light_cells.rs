@@ -95,6 +95,7 @@ pub(crate) fn size_by_cells(probe: &Image<Rgb>, lights: &mut [Light]) -> Result<
     for (l, c) in lights.iter_mut().zip(&cells) {
         let spread = c.histogram.spread_sr();
         if c.solid_angle_sr > 0.0 && spread.is_some() {
+            let side = l.side;
             *l = light(
                 l.direction,
                 l.irradiance.to_array(),
@@ -103,6 +104,7 @@ pub(crate) fn size_by_cells(probe: &Image<Rgb>, lights: &mut [Light]) -> Result<
                 l.region,
             );
             l.core_fraction = core_fraction(&c.histogram, l, WIDEST_CORE_IN_A_CLUSTER);
+            l.side = side;
         }
     }
     Ok(())
@@ -184,6 +186,7 @@ mod tests {
             region: None,
             spread_sr: None,
             core_fraction: None,
+            side: None,
         }
     }
 

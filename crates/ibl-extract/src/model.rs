@@ -199,6 +199,7 @@ fn sun_set(
             region: None,
             spread_sr: None,
             core_fraction: None,
+            side: None,
         }],
     })
 }

@@ -670,5 +670,6 @@ pub(crate) fn light(
         region,
         spread_sr: spread,
         core_fraction: None,
+        side: None,
     }
 }

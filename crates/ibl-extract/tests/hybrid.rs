@@ -49,6 +49,7 @@ fn sun_light(probe: &Image<Rgb>) -> LightSet {
             region: None,
             spread_sr: None,
             core_fraction: None,
+            side: None,
         }],
     }
 }

@@ -130,11 +130,25 @@ fn half(probe: &Image<Rgb>, upper: bool) -> Image<Rgb> {
     })
 }
 
-/// The irradiance of the lights on one side of the horizon (`y > 0` when `upper`) at `n`.
-fn side_irradiance(set: &ibl_light::LightSet, n: DVec3, upper: bool) -> [f64; 3] {
+/// The irradiance at `n` of the lights that stand for one side of the horizon (above when
+/// `upper`), each as soft shadows render it: its cones folded onto its side
+/// (`Light::soft_points`, 256 points a cone), or as a point (`soft` false).
+fn side_irradiance(set: &ibl_light::LightSet, n: DVec3, upper: bool, soft: bool) -> [f64; 3] {
+    let side = if upper {
+        ibl_light::HorizonSide::Above
+    } else {
+        ibl_light::HorizonSide::Below
+    };
     let mut e = [0.0; 3];
-    for l in set.lights.iter().filter(|l| (l.direction.y > 0.0) == upper) {
-        let c = n.dot(l.direction).max(0.0);
+    for l in set.lights.iter().filter(|l| l.side == Some(side)) {
+        let c: f64 = if soft {
+            l.soft_points(256)
+                .iter()
+                .map(|(p, w)| w * n.dot(*p).max(0.0))
+                .sum()
+        } else {
+            n.dot(l.direction).max(0.0)
+        };
         for ch in 0..3 {
             e[ch] += l.irradiance[ch] * c;
         }
@@ -149,10 +163,13 @@ fn fitted_apart_the_lights_carry_what_a_ground_lets_through() {
     // whole sphere, a light may stand for light from both sides of the horizon, so the lights
     // above it carry E_up badly; fitted apart (fit_hemispheres), the lights above the
     // horizon carry E_up and those below carry E_down, each to the accuracy of a fit of that
-    // many lights. Apartment probe, 16 lights, scored on 20000 normals (measured: mean error of
-    // E_up 8.03 % whole-sphere, 1.83 % apart; E_down 8.92 % and 2.00 %). Bounds: apart below
-    // 3 %, whole-sphere above 6 %: a third or more of margin on each side, for another CPU's
-    // nearby local minimum (the golden test allows a fit 15 %).
+    // many lights, as the renderer draws them: soft, folded onto their side, with the powers
+    // solved for that. Apartment probe, 16 lights, scored on 20000 normals (measured: mean error
+    // of E_up 8.03 % whole-sphere (as points: it gives its lights no side), 0.52 % apart; E_down
+    // 8.92 % and 0.81 %; the same lights taken as points, 2.26 % and 2.77 %: their powers are
+    // solved for the soft model). Bounds: apart below 1.2 %, whole-sphere above 6 %: a third or
+    // more of margin on each side, for another CPU's nearby local minimum (the golden test
+    // allows a fit 15 %).
     let (_, apt) = probes()
         .into_iter()
         .find(|(n, _)| n == "apartment")
@@ -164,28 +181,60 @@ fn fitted_apart_the_lights_carry_what_a_ground_lets_through() {
     let sphere = irradiance_optimization(&apt, 16, &o).unwrap();
     let apart = fit_hemispheres(&apt, 16, &o).unwrap();
     for (k, upper) in [true, false].into_iter().enumerate() {
-        let err = |fit: &ibl_extract::Fit| {
+        let whole = {
             let approx: Vec<[f64; 3]> = normals
                 .iter()
-                .map(|&n| side_irradiance(&fit.set, n, upper))
+                .map(|&n| {
+                    let mut e = [0.0; 3];
+                    for l in sphere.set.lights.iter() {
+                        if (l.direction.y > 0.0) == upper {
+                            let c = n.dot(l.direction).max(0.0);
+                            for ch in 0..3 {
+                                e[ch] += l.irradiance[ch] * c;
+                            }
+                        }
+                    }
+                    e
+                })
                 .collect();
             errors(&truth[k], &approx).0
         };
-        let (whole, split) = (err(&sphere), err(&apart));
-        println!("upper {upper}: mean error whole sphere {whole:.2} %, apart {split:.2} %");
-        assert!(split < 3.0 && whole > 6.0, "{split} {whole}");
+        let apart_err = |soft: bool| {
+            let approx: Vec<[f64; 3]> = normals
+                .iter()
+                .map(|&n| side_irradiance(&apart.set, n, upper, soft))
+                .collect();
+            errors(&truth[k], &approx).0
+        };
+        let (split, as_points) = (apart_err(true), apart_err(false));
+        println!(
+            "upper {upper}: mean error whole sphere {whole:.2} %, apart {split:.2} % (as points \
+             {as_points:.2} %)"
+        );
+        assert!(split < 1.2 && whole > 6.0, "{split} {whole}");
     }
     // The report says how the lights were shared: by the halves' powers (52 % above: 8 of 16),
-    // each half's lights on its side of the horizon.
+    // each half's lights marked with their side and on it (or on the horizon); the whole
+    // sphere's have no side.
     assert_eq!(sphere.report.lights_above_horizon, None);
+    assert!(sphere.set.lights.iter().all(|l| l.side.is_none()));
     assert_eq!(apart.report.lights_above_horizon, Some(8));
-    let above = apart
+    let above = ibl_light::HorizonSide::Above;
+    let count = apart
         .set
         .lights
         .iter()
-        .filter(|l| l.direction.y > 0.0)
+        .filter(|l| l.side == Some(above))
         .count();
-    assert_eq!(above, 8);
+    assert_eq!(count, 8);
+    for l in &apart.set.lights {
+        let side = l.side.expect("a side");
+        assert!(
+            l.direction.dot(side.up()) >= 0.0,
+            "{:?} {side:?}",
+            l.direction
+        );
+    }
     assert!(apart.report.converged);
 }
 
@@ -202,7 +251,7 @@ fn hemispheres_of_one_light_or_one_lit_half_fit_as_one() {
     let upper = half(&probe, true);
     let fit = fit_hemispheres(&upper, 6, &o).unwrap();
     assert_eq!(fit.report.lights_above_horizon, Some(6));
-    assert!(fit.set.lights.iter().all(|l| l.direction.y > 0.0));
+    assert!(fit.set.lights.iter().all(|l| l.direction.y >= 0.0));
 }
 
 #[test]

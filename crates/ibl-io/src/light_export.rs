@@ -534,6 +534,7 @@ mod tests {
             region: None,
             spread_sr: None,
             core_fraction: None,
+            side: None,
         }
     }
 

@@ -226,6 +226,11 @@ pub fn read_light_set(path: &Path) -> Result<LightSet, IoError> {
     light_set_from_json(path, &bytes)
 }
 
+/// How far (as `y`, probe frame) a light with a [`ibl_light::Light::side`] may lie on the other
+/// side of the horizon: the file's rounding of a light on the horizon (directions are written
+/// with 17 significant digits, so this is generous).
+const SIDE_TOLERANCE: f64 = 1e-9;
+
 /// [`read_light_set`] on a file's bytes (`path` names it in errors).
 pub fn light_set_from_json(path: &Path, bytes: &[u8]) -> Result<LightSet, IoError> {
     let file = LightsFile::from_json(path, bytes)?;
@@ -241,14 +246,17 @@ pub fn light_set_from_json(path: &Path, bytes: &[u8]) -> Result<LightSet, IoErro
             && l.solid_angle_sr >= 0.0
             && l.spread_sr
                 .is_none_or(|a| a.is_finite() && (0.0..=4.0 * std::f64::consts::PI).contains(&a))
-            && l.core_fraction.is_none_or(|f| (0.0..=1.0).contains(&f));
+            && l.core_fraction.is_none_or(|f| (0.0..=1.0).contains(&f))
+            && l.side
+                .is_none_or(|side| side.up().dot(l.direction) >= -SIDE_TOLERANCE);
         if !ok {
             return Err(IoError::Invalid {
                 path: path.to_path_buf(),
                 reason: format!(
                     "light {i}: direction must be a unit vector, irradiance and solid angle \
                      finite and non-negative, spread (if given) from 0 to 4 pi sr and \
-                     core_fraction (if given) from 0 to 1"
+                     core_fraction (if given) from 0 to 1, and a light with a side (\"above\" \
+                     or \"below\") on that side of the horizon or on it"
                 ),
             });
         }
@@ -263,7 +271,7 @@ mod tests {
     use ibl_core::Rgb;
     use ibl_core::glam::DVec3;
     use ibl_core::rgb::Rgb64;
-    use ibl_light::{FitReport, PixelRegion};
+    use ibl_light::{FitReport, HorizonSide, PixelRegion};
 
     fn file(frame: FramePreset) -> LightsFile {
         LightsFile {
@@ -300,6 +308,7 @@ mod tests {
                     }),
                     spread_sr: Some(0.25),
                     core_fraction: Some(0.75),
+                    side: None,
                 }],
             },
             frame,
@@ -361,5 +370,47 @@ mod tests {
         );
         std::fs::write(&path, b"{\"format\": \"other/1\"}").expect("writes");
         assert!(read_lights_file(&path).is_err_and(|e| e.is_bad_input()));
+    }
+
+    #[test]
+    fn a_lights_side_of_the_horizon_round_trips_and_must_hold() {
+        // Blender's file axes: the file's (0.6, 0.8, 0) is ours (0.6, 0, -0.8), on the horizon;
+        // "above" and "below" name our horizon whatever the preset.
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join("l.json");
+        for side in [HorizonSide::Above, HorizonSide::Below] {
+            let mut want = file(FramePreset::Blender);
+            want.set.lights[0].side = Some(side);
+            write_lights_file(&path, &want).expect("writes");
+            let text = std::fs::read_to_string(&path).expect("reads");
+            let name = if side == HorizonSide::Above {
+                "above"
+            } else {
+                "below"
+            };
+            assert!(text.contains(&format!("\"side\": \"{name}\"")), "{text}");
+            assert_eq!(read_lights_file(&path).expect("reads"), want);
+            assert_eq!(
+                read_light_set(&path).expect("reads").lights[0].side,
+                Some(side)
+            );
+        }
+        // A light said to stand for the light above the horizon that lies below it.
+        let mut bad = file(FramePreset::Gltf);
+        bad.set.lights[0].side = Some(HorizonSide::Above);
+        bad.set.lights[0].direction = DVec3::new(0.6, -0.8, 0.0);
+        write_lights_file(&path, &bad).expect("writes");
+        let e = read_light_set(&path).unwrap_err();
+        assert!(e.is_bad_input() && e.to_string().contains("side"), "{e}");
+        std::fs::write(&path, text_with_side("sideways")).expect("writes");
+        assert!(read_light_set(&path).is_err_and(|e| e.is_bad_input()));
+    }
+
+    /// A one-light file whose light's side is `side`.
+    fn text_with_side(side: &str) -> String {
+        file(FramePreset::Gltf).to_json().replace(
+            "\"core_fraction\": 0.75",
+            &format!("\"core_fraction\": 0.75, \"side\": \"{side}\""),
+        )
     }
 }

@@ -75,6 +75,35 @@ pub struct Light {
     /// with the spread; `None` (all core) where not measured.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub core_fraction: Option<f64>,
+    /// The side of the probe's horizon (`y = 0` in the probe's frame) whose light alone this
+    /// light stands for, where its extraction kept the halves apart (irradiance optimisation
+    /// with the hemispheres apart, `ibl_extract::fit_hemispheres`): its direction lies on that
+    /// side or on the horizon, and soft shadows fold the part of its cones that crosses the
+    /// horizon back onto that side (the mirror image in the horizon plane), so that a ground
+    /// plane neither hides light from above nor passes light from below. `None`: the light's
+    /// cones are taken whole.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub side: Option<HorizonSide>,
+}
+
+/// A side of the probe's horizon ([`Light::side`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum HorizonSide {
+    /// `y >= 0` in the probe's frame.
+    Above,
+    /// `y <= 0` in the probe's frame.
+    Below,
+}
+
+impl HorizonSide {
+    /// The unit normal of the horizon plane pointing into this side, probe frame.
+    pub fn up(self) -> DVec3 {
+        match self {
+            HorizonSide::Above => DVec3::Y,
+            HorizonSide::Below => DVec3::NEG_Y,
+        }
+    }
 }
 
 /// The two uniform cones about a light's direction that stand for it in soft shadows and in the
@@ -200,6 +229,7 @@ mod tests {
                     region: None,
                     spread_sr: None,
                     core_fraction: None,
+                    side: None,
                 },
                 Light {
                     direction: DVec3::NEG_Z,
@@ -214,6 +244,7 @@ mod tests {
                     }),
                     spread_sr: Some(0.125),
                     core_fraction: None,
+                    side: None,
                 },
             ],
         }

@@ -28,10 +28,11 @@ pub mod goniometric;
 pub mod method;
 pub mod patch;
 pub mod provenance;
+pub mod soft_points;
 pub mod spread;
 
 pub use daylight::{Sky, Sun};
-pub use directional::{Light, LightSet, PixelRegion, ShadowCones};
+pub use directional::{HorizonSide, Light, LightSet, PixelRegion, ShadowCones};
 pub use goniometric::equal_area::EqualAreaMap;
 pub use goniometric::{CandelaTable, GoniometricLight, PhotometryError, intensity_per_candela_for};
 pub use method::{LightSource, MAX_MEDIAN_CUT_SPLITS, Method, MethodError};

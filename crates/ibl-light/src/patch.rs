@@ -63,6 +63,7 @@ impl AreaPatch {
             region: None,
             spread_sr: None,
             core_fraction: None,
+            side: None,
         })
     }
 }

@@ -213,6 +213,7 @@ pub fn sun_light(sun: &SunLight) -> Option<DirectionalLight> {
         cone: UniformCone::from_half_angle(SUN_ANGULAR_RADIUS as f32),
         halo: None,
         frame: OrthonormalBasis::from_normal(direction),
+        fold: None,
     })
 }
 

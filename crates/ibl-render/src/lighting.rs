@@ -87,9 +87,24 @@ pub struct DirectionalLight {
     pub halo: Option<(UniformCone, f32)>,
     /// The basis about `direction` in which the cone is sampled.
     pub frame: OrthonormalBasis,
+    /// Where the light stands for one side of the probe's horizon only
+    /// ([`ibl_light::Light::side`]) and its widest cone crosses the horizon: the unit normal
+    /// of the horizon plane pointing into its side, world frame. Soft shadows then mirror a cone
+    /// point on the other side into this one ([`DirectionalLight::folded`]). `None`: the cones
+    /// are taken whole.
+    pub fold: Option<Vec3>,
 }
 
 impl DirectionalLight {
+    /// The cone point `point` (unit, world frame) as the light's soft shadows take it: mirrored
+    /// in the horizon plane onto the light's side where it has a [`DirectionalLight::fold`] and
+    /// the point lies on the other side; `None` where it is not moved.
+    pub fn folded(&self, point: Vec3) -> Option<Vec3> {
+        let up = self.fold?;
+        let height = point.dot(up);
+        (height < 0.0).then(|| point - 2.0 * height * up)
+    }
+
     /// The mean clamped cosine of the light's cones (shares as weights) to a normal at
     /// `cos_beta` from its direction ([`UniformCone::mean_clamped_cosine`]); `cos_beta`
     /// clamped at 0 without a cone.
@@ -376,13 +391,36 @@ fn with_finer_bands(probe: &Image<Rgb>, lights: &LightSet, ambient: &RadianceSh)
     RadianceSh::new(bands, coefficients).unwrap_or_else(|_| ambient.clone())
 }
 
+/// Quadrature points per cone for the SH of a light folded onto its side of the horizon
+/// ([`ibl_light::Light::soft_points`]): spiral points about 3 degrees apart in a 30-degree cone,
+/// where band 15 varies over about 24 degrees.
+const FOLDED_SH_POINTS_PER_CONE: usize = 256;
+
 /// `ambient + sum_i I_i (1 - g_l(c_i)) Y_lm(w_i)`: a point-subtracted ambient turned into the
 /// ambient of the same lights as uniform cones (module notes; a light with a halo as its two
-/// cones, `g_l` the share-weighted mean of theirs), probe frame.
+/// cones, `g_l` the share-weighted mean of theirs; a light with a side of the horizon as its
+/// cones folded onto it, by quadrature), probe frame.
 fn with_cones_spread(ambient: &RadianceSh, lights: &LightSet) -> RadianceSh {
     let bands = ambient.bands();
     let mut coefficients = ambient.coefficients().to_vec();
     for light in &lights.lights {
+        if light.side.is_some() {
+            // A light folded onto its side of the horizon is not a uniform cone: its spread
+            // `Y(w) - sum_p w_p Y(p)` by quadrature over its folded cones.
+            let power = [light.irradiance.r, light.irradiance.g, light.irradiance.b];
+            let mut spread = basis(light.direction, bands);
+            for (p, w) in light.soft_points(FOLDED_SH_POINTS_PER_CONE) {
+                for (s, y) in spread.iter_mut().zip(basis(p, bands)) {
+                    *s -= w * y;
+                }
+            }
+            for (k, s) in spread.iter().enumerate() {
+                for (v, power) in coefficients[k].iter_mut().zip(power) {
+                    *v += power * s;
+                }
+            }
+            continue;
+        }
         let cones = light.shadow_cones();
         let a = cones.core_sr;
         if !(a.is_finite() && a > 0.0) {
@@ -439,6 +477,18 @@ pub fn cap_zonal_factors(one_minus_c: f64, bands: usize) -> Vec<f64> {
         .collect()
 }
 
+/// Whether the uniform cone of solid angle `solid_angle_sr` about unit `axis` reaches below the
+/// plane of unit normal `up` (its half-angle exceeds the axis's elevation above the plane).
+fn crosses_plane(axis: DVec3, up: DVec3, solid_angle_sr: f64) -> bool {
+    if !(solid_angle_sr.is_finite() && solid_angle_sr > 0.0) {
+        return false;
+    }
+    let cos_half = (1.0 - solid_angle_sr / TAU).max(-1.0);
+    let half = cos_half.acos();
+    let elevation = axis.dot(up).clamp(-1.0, 1.0).asin();
+    half > elevation
+}
+
 fn light_list(scene: &Scene, set: &LightSet, shadows: ShadowKind) -> LightList {
     LightList::from_set(set, scene.probe.world_from_probe.as_dmat3(), shadows)
 }
@@ -471,6 +521,11 @@ impl LightList {
                         UniformCone::from_solid_angle(sr as f32).map(|c| (c, share as f32))
                     }),
                     frame: OrthonormalBasis::from_normal(direction),
+                    fold: l.side.and_then(|side| {
+                        let up = (world_from_set * side.up()).normalize_or(DVec3::Y);
+                        let widest = cones.halo.map_or(cones.core_sr, |(sr, _)| sr);
+                        crosses_plane(direction.as_dvec3(), up, widest).then(|| up.as_vec3())
+                    }),
                 }
             })
             .collect();

@@ -574,7 +574,11 @@ impl<'a> Tracer<'a> {
     /// cone point below the shading surface adds nothing (`c_s = 0`) and sends no ray; one above
     /// it but below the geometric surface is blocked by the surface itself. A light whose answer
     /// is known for the whole cone (adaptive antialiasing's agreeing neighbours) adds its exact
-    /// light where open and nothing where blocked, with no cone point.
+    /// light where open and nothing where blocked, with no cone point. A light folded onto its
+    /// side of the horizon ([`crate::lighting::DirectionalLight::fold`]) has no closed form:
+    /// it adds `f I c_s V(w_s)` for its mirrored cone point (per cone, by share), unbiased and
+    /// never negative (the per-sample light is clamped at zero, which a control variate's
+    /// negative corrections would bias), and is never lent by its neighbours.
     fn lights(
         &self,
         list: &LightList,
@@ -597,13 +601,20 @@ impl<'a> Tracer<'a> {
                     let f = cone_bsdf(vertex, axis, cos_beta);
                     // A light with a halo draws a cone point in each of its two cones.
                     let points = if light.halo.is_some() { 2 } else { 1 };
-                    if mean_cos <= 0.0 || f.max_channel() <= 0.0 {
+                    // A folded light's mirrored points may face a surface its whole cones do
+                    // not face.
+                    if (mean_cos <= 0.0 && light.fold.is_none()) || f.max_channel() <= 0.0 {
                         (0..points).for_each(|_| stream.skip_2d());
                         continue;
                     }
                     let light_value = f * light.irradiance;
                     let halo = light.halo;
-                    let known = state.known.occlusion(index);
+                    // A folded light's unshadowed value is not its cones' mean cosine, so its
+                    // neighbourhood's answer cannot stand for it.
+                    let known = state
+                        .known
+                        .occlusion(index)
+                        .filter(|_| light.fold.is_none());
                     if let Some(occlusion) =
                         known.filter(|&o| halo.is_none() || o == Occlusion::Open)
                     {
@@ -623,13 +634,20 @@ impl<'a> Tracer<'a> {
                     // would otherwise take off the whole sun 4 % of the time, speckles at 4
                     // samples a pixel); its record for the neighbourhood is "open" where both
                     // rays were, else the first blocked one's answer.
-                    sum.add_all(light_value * mean_cos);
+                    // A light folded onto its side of the horizon has no closed-form unshadowed
+                    // value: each of its (mirrored) cone points adds its own light where open,
+                    // unbiased and never negative, at the price of noise on open surfaces.
+                    let folded = light.fold.is_some();
+                    if !folded {
+                        sum.add_all(light_value * mean_cos);
+                    }
                     let core_share = halo.map_or(1.0, |(_, share)| 1.0 - share);
                     let cones = std::iter::once((core, core_share)).chain(halo);
                     let mut record = None;
                     for (cone, share) in cones {
                         let [u1, u2] = stream.next_2d();
-                        let point = light.frame.to_world(cone.sample(u1, u2));
+                        let sampled = light.frame.to_world(cone.sample(u1, u2));
+                        let point = light.folded(sampled).unwrap_or(sampled);
                         let cos = surface.shading_normal.dot(point);
                         if cos <= 0.0 {
                             // Below the shading surface the cone adds nothing: nothing to take
@@ -651,7 +669,11 @@ impl<'a> Tracer<'a> {
                         } else {
                             self.light_occlusion(origin, point, index, state)
                         };
-                        sum.add_blocked(occlusion, light_value * (share * -cos));
+                        if folded {
+                            sum.add(occlusion, light_value * (share * cos));
+                        } else {
+                            sum.add_blocked(occlusion, light_value * (share * -cos));
+                        }
                     }
                     if let Some(occlusion) = record {
                         state.seen.record(index, occlusion);

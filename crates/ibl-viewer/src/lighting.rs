@@ -302,6 +302,7 @@ mod tests {
                 }),
                 spread_sr: None,
                 core_fraction: None,
+                side: None,
             }],
         };
         let mask = region_borders(&set, 8, 6).expect("a region");

@@ -518,6 +518,7 @@ mod tests {
             cone: ibl_render::sampling::UniformCone::from_solid_angle(solid_angle),
             halo: None,
             frame: ibl_render::sampling::OrthonormalBasis::from_normal(Vec3::Y),
+            fold: None,
         };
         assert_eq!(cone_tangent(&light(0.0)), 0.0);
         // A cone of half-angle a has solid angle 2 pi (1 - cos a); a = 30 degrees.
