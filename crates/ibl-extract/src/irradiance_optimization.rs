@@ -229,24 +229,6 @@ pub fn irradiance_optimization(
     Ok(fit)
 }
 
-/// The error of `lights` against the irradiance `target` on `normals` (as [`fit_irradiance`]
-/// takes them): `(fit_rms_err_pct, fit_mean_abs_err_pct)` as a [`FitReport`] states them, each
-/// channel scaled by its mean target irradiance. For light sets not fitted in one piece
-/// (module `hemispheres`).
-pub(crate) fn fit_errors(normals: Vec<DVec3>, target: &[[f64; 3]], lights: &[Light]) -> (f64, f64) {
-    let problem = Problem::new(normals, target, LightDomain::Sphere);
-    let lights = Lights {
-        dirs: lights.iter().map(|l| l.direction).collect(),
-        log_power: lights
-            .iter()
-            .map(|l| l.irradiance.to_array().map(|v| v.max(0.0).ln()))
-            .collect(),
-    };
-    let (_, cost) = problem.residuals(&lights);
-    let rms = 100.0 * (2.0 * cost / (3 * problem.normals.len()) as f64).sqrt();
-    (rms, problem.mean_abs_err_pct(&lights))
-}
-
 /// Where a fit may put its lights' directions (world frame, +Y up).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum LightDomain {

@@ -39,9 +39,12 @@ pub struct FitReport {
     pub initial_cost: f64,
     /// Cost `F` at the end.
     pub final_cost: f64,
-    /// RMS of the scaled residuals on the fitting normals at the end, % of mean irradiance.
+    /// RMS of the scaled residuals on the fitting normals at the end, % of mean irradiance
+    /// (the lights as points; with the hemispheres apart, as soft shadows draw them: their
+    /// cones folded onto their side, for which their powers were solved).
     pub fit_rms_err_pct: f64,
-    /// Mean absolute error on the fitting normals at the end, % of mean irradiance.
+    /// Mean absolute error on the fitting normals at the end, % of mean irradiance (scored as
+    /// `fit_rms_err_pct` is).
     pub fit_mean_abs_err_pct: f64,
     /// Number of fitting normals.
     pub fit_normals: usize,
