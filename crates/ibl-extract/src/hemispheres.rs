@@ -97,8 +97,13 @@ pub fn fit_hemispheres(
     }
     let n_up = lights_above(n, power);
     let halves = [
-        (0..upper_rows, n_up, LightDomain::Above),
-        (upper_rows..probe.height(), n - n_up, LightDomain::Below),
+        (0..upper_rows, n_up, LightDomain::Above, HorizonSide::Above),
+        (
+            upper_rows..probe.height(),
+            n - n_up,
+            LightDomain::Below,
+            HorizonSide::Below,
+        ),
     ];
     let normals = fit_normals();
     let mut lights: Vec<Light> = Vec::with_capacity(n);
@@ -108,7 +113,7 @@ pub fn fit_hemispheres(
         ..FitReport::default()
     };
     let mut targets = Vec::with_capacity(2);
-    for (rows, count, domain) in halves {
+    for (rows, count, domain, side) in halves {
         if count == 0 {
             continue;
         }
@@ -116,10 +121,6 @@ pub fn fit_hemispheres(
         let target = RowIrradiance::new(&half).irradiance(&normals);
         let first = lights.len();
         let mut fit = fit_irradiance_in(normals.clone(), target.clone(), count, options, domain)?;
-        let side = match domain {
-            LightDomain::Below => HorizonSide::Below,
-            _ => HorizonSide::Above,
-        };
         for light in &mut fit.set.lights {
             light.side = Some(side);
         }
@@ -135,14 +136,20 @@ pub fn fit_hemispheres(
     // Every light sized by its cell among all the lights (module `light_cells`), as the
     // whole-sphere fit's are.
     size_by_cells(probe, &mut lights)?;
-    // Each half's powers solved again for its lights as soft shadows render them.
+    // Each half's powers solved again for its lights as soft shadows render them; the report
+    // scores the halves' lights together as drawn.
+    let mut drawn = vec![[0.0; 3]; normals.len()];
     for (range, target) in &targets {
-        resolve_soft_powers(&mut lights[range.clone()], &normals, target);
+        let half = resolve_soft_powers(&mut lights[range.clone()], &normals, target);
+        for (d, h) in drawn.iter_mut().zip(half) {
+            for (dc, hc) in d.iter_mut().zip(h) {
+                *dc += hc;
+            }
+        }
     }
     let target = RowIrradiance::new(probe).irradiance(&normals);
     report.fit_normals = normals.len();
-    (report.fit_rms_err_pct, report.fit_mean_abs_err_pct) =
-        soft_fit_errors(&normals, &target, &lights);
+    (report.fit_rms_err_pct, report.fit_mean_abs_err_pct) = scaled_errors(&target, &drawn);
     let lum = |l: &Light| l.irradiance.luminance();
     lights.sort_by(|a, b| lum(b).total_cmp(&lum(a)));
     Ok(Fit {
@@ -158,36 +165,51 @@ pub fn fit_hemispheres(
 /// the mean clamped cosine over 64 spiral points of a cap is within about 0.1 % of the exact one.
 const SOFT_POINTS_PER_CONE: usize = 64;
 
-/// Solves the powers of `lights` (one half's, sized by their cells) again, by non-negative least
-/// squares per channel against the half's irradiance `target` on `normals`, with each light taken
-/// as soft shadows render it ([`Light::soft_points`]: its cones, folded onto its side of the
-/// horizon) instead of as the point the fit moved: `A_kj = sum_p w_p max(0, n_k . p)`. Directions,
-/// solid angles and spreads are kept; radiance follows the power (`L = I / A`).
-fn resolve_soft_powers(lights: &mut [Light], normals: &[DVec3], target: &[[f64; 3]]) {
+/// The soft model of `lights` on `normals`: `A_kj = sum_p w_p max(0, n_k . p)`, the irradiance
+/// light `j` gives normal `k` per unit power as soft shadows draw it ([`Light::soft_points`]: its
+/// cones, folded onto its side of the horizon). M x N, columns in parallel.
+fn soft_cosines(lights: &[Light], normals: &[DVec3]) -> DMatrix<f64> {
     let m = normals.len();
-    if lights.is_empty() || m == 0 || target.len() != m {
-        return;
-    }
-    let points: Vec<Vec<(DVec3, f64)>> = lights
-        .iter()
-        .map(|l| l.soft_points(SOFT_POINTS_PER_CONE))
-        .collect();
     let mut a = DMatrix::zeros(m, lights.len());
     a.as_mut_slice()
-        .par_chunks_mut(m)
-        .zip(&points)
-        .for_each(|(column, points)| {
+        .par_chunks_mut(m.max(1))
+        .zip(lights)
+        .for_each(|(column, light)| {
+            let points = light.soft_points(SOFT_POINTS_PER_CONE);
             for (v, n) in column.iter_mut().zip(normals) {
                 *v = points.iter().map(|(p, w)| w * n.dot(*p).max(0.0)).sum();
             }
         });
+    a
+}
+
+/// Solves the powers of `lights` (one half's, sized by their cells) again, by non-negative least
+/// squares per channel against the half's irradiance `target` on `normals`, with each light taken
+/// as soft shadows render it ([`soft_cosines`]) instead of as the point the fit moved.
+/// Directions, solid angles and spreads are kept; radiance follows the power (`L = I / A`).
+/// Returns the half's irradiance on `normals` with the new powers, as drawn (zero where there is
+/// nothing to solve).
+fn resolve_soft_powers(
+    lights: &mut [Light],
+    normals: &[DVec3],
+    target: &[[f64; 3]],
+) -> Vec<[f64; 3]> {
+    let m = normals.len();
+    let mut drawn = vec![[0.0; 3]; m];
+    if lights.is_empty() || m == 0 || target.len() != m {
+        return drawn;
+    }
+    let a = soft_cosines(lights, normals);
     let q = gram(&a);
     let mut powers = vec![[0.0; 3]; lights.len()];
     for c in 0..3 {
         let y = DVector::from_iterator(m, target.iter().map(|t| t[c]));
-        let x = nnls_gram(&q, &a.tr_mul(&y));
+        let x = nnls_gram(&q, &a.tr_mul(&y)).map(|v| v.max(0.0));
+        for (d, e) in drawn.iter_mut().zip((&a * &x).iter()) {
+            d[c] = *e;
+        }
         for (p, v) in powers.iter_mut().zip(x.iter()) {
-            p[c] = v.max(0.0);
+            p[c] = *v;
         }
     }
     for (l, p) in lights.iter_mut().zip(powers) {
@@ -197,23 +219,19 @@ fn resolve_soft_powers(lights: &mut [Light], normals: &[DVec3], target: &[[f64; 
             l.radiance = Rgb::new((p[0] / a) as f32, (p[1] / a) as f32, (p[2] / a) as f32);
         }
     }
+    drawn
 }
 
-/// The error of `lights` as soft shadows draw them ([`Light::soft_points`], their cones folded
-/// onto their side) against the irradiance `target` on `normals`: `(fit_rms_err_pct,
-/// fit_mean_abs_err_pct)` as a [`FitReport`] states them, each channel's residual scaled by the
-/// channel's mean target irradiance (a channel without irradiance counts as no error), the RMS
-/// over all three channels and the mean over the channels that have irradiance. Per-normal
-/// values in parallel, summed in order: the same bits whatever the thread count.
-fn soft_fit_errors(normals: &[DVec3], target: &[[f64; 3]], lights: &[Light]) -> (f64, f64) {
-    let m = normals.len().min(target.len());
+/// The error of the irradiance `drawn` against `target` (the same normals):
+/// `(fit_rms_err_pct, fit_mean_abs_err_pct)` as a [`FitReport`] states them, each channel's
+/// residual scaled by the channel's mean target irradiance (a channel without irradiance counts
+/// as no error), the RMS over all three channels and the mean over the channels that have
+/// irradiance. Summed in order: the same bits whatever the thread count.
+fn scaled_errors(target: &[[f64; 3]], drawn: &[[f64; 3]]) -> (f64, f64) {
+    let m = drawn.len().min(target.len());
     if m == 0 {
         return (0.0, 0.0);
     }
-    let points: Vec<Vec<(DVec3, f64)>> = lights
-        .iter()
-        .map(|l| l.soft_points(SOFT_POINTS_PER_CONE))
-        .collect();
     let inv_mu = channel_means(&target[..m]).map(|v| {
         if v.is_finite() && v > 0.0 {
             1.0 / v
@@ -221,22 +239,11 @@ fn soft_fit_errors(normals: &[DVec3], target: &[[f64; 3]], lights: &[Light]) -> 
             0.0
         }
     });
-    let residuals: Vec<[f64; 3]> = normals[..m]
-        .par_iter()
-        .zip(&target[..m])
-        .map(|(n, g)| {
-            let mut e = [0.0; 3];
-            for (points, light) in points.iter().zip(lights) {
-                let c: f64 = points.iter().map(|(p, w)| w * n.dot(*p).max(0.0)).sum();
-                for (ec, pc) in e.iter_mut().zip(light.irradiance.to_array()) {
-                    *ec += pc * c;
-                }
-            }
-            [0, 1, 2].map(|c| (e[c] - g[c]) * inv_mu[c])
-        })
-        .collect();
-    let squares: f64 = residuals.iter().flatten().map(|r| r * r).sum();
-    let absolute: f64 = residuals.iter().flatten().map(|r| r.abs()).sum();
+    let residuals = drawn
+        .iter()
+        .zip(target)
+        .flat_map(|(e, g)| [0, 1, 2].map(|c| (e[c] - g[c]) * inv_mu[c]));
+    let (squares, absolute) = residuals.fold((0.0, 0.0), |(s, a), r| (s + r * r, a + r.abs()));
     let channels = inv_mu.iter().filter(|&&v| v > 0.0).count().max(1);
     (
         100.0 * (squares / (3 * m) as f64).sqrt(),
