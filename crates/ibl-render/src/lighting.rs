@@ -28,7 +28,7 @@
 //! clamped at 0 per channel.
 //!
 //! **The ambient's two band counts.** The occlusion rays read the ambient in the scene's
-//! `ambient_bands` (5), but a surface nothing occludes gets its irradiance in
+//! `ambient_bands` (7), but a surface nothing occludes gets its irradiance in
 //! [`MAX_AMBIENT_BANDS`] (16): the probe less the lights is carried on to 16 bands
 //! (`with_finer_bands`: the probe projected again, the lights taken off as points), and the
 //! irradiance of the bands above the rays' is tabulated over normals ([`NormalTable`]). So on an
@@ -42,6 +42,23 @@
 //! reference's noise floor: 3.74x with 5 bands for both, 3.41x with 9 for both, 2.25x with 16
 //! for the open surface and 5 for the rays; BENCHMARKS.md, "The hybrid's open surfaces in every
 //! band").
+//!
+//! **The ambient at the horizon.** The probe less the lights jumps at the horizon: a ground's
+//! pixels meet the sky's there, and lights held on one side of it (irradiance optimisation's,
+//! folded onto their side) leave the other side's residual untouched. A band-limited expansion
+//! of a jump rings on both sides of it, and a surface above a ground plane reads that ringing
+//! through every ray the ground blocks. So the rays read each half of the horizon from its own
+//! expansion ([`horizon_halves`]): the half mirrored across the horizon onto the other (`r(w)`
+//! on its side, `r(w')` on the other, `w'` the mirror image), continuous where the whole jumps,
+//! so its bands converge without the jump's ringing. The estimate starts from the upper half's
+//! irradiance alone, `E_up(n)` (the probe's upper rows less the lights' points above the
+//! horizon, 16 bands, tabulated as above), takes off what blocked rays above the horizon read
+//! and adds what open rays below it read: a surface over a ground that hides exactly the lower
+//! half (the usual case: the probe was taken above a floor) then gets no noise and no ringing
+//! from below, and the open sky none from above. The same expectation as before, with every
+//! band read where it converges; with the jump gone, bands up to 6 pay for the rays
+//! (`ambient_bands` 5 -> 7; converged, on the render study's two scenes, every method's hybrid
+//! as good as before or better, BENCHMARKS.md "The ambient at the horizon").
 //!
 //! **Goniometric lights** (Grosch 2005 section 4.2, new light sources): in every mode the
 //! lighting may also hold point lights with measured intensity distributions
@@ -62,7 +79,7 @@ use std::f64::consts::TAU;
 
 use glam::{DMat3, DVec3, Vec3};
 use ibl_core::{Image, LatLong, Rgb};
-use ibl_light::{GoniometricLight, LightSet};
+use ibl_light::{GoniometricLight, HorizonSide, LightSet};
 use ibl_scene::{Scene, ShadowKind};
 use ibl_sh::{
     IrradianceSh, RadianceSh, Window, basis, eval_basis, project_latlong, subtract_point_sources,
@@ -146,6 +163,46 @@ pub struct Ambient {
     finer: Option<NormalTable>,
     /// Occlusion rays per shading point, at least 1.
     pub occlusion_rays: u32,
+    /// What the rays read on either side of the probe's horizon, where the ambient has
+    /// halves ([`Ambient::with_horizon_halves`]).
+    halves: Option<HorizonHalves>,
+}
+
+/// The hybrid ambient split at the probe's horizon (module notes, "The ambient at the
+/// horizon"), world frame.
+#[derive(Clone, Debug)]
+struct HorizonHalves {
+    /// The unit normal of the horizon plane pointing up, world frame.
+    up: Vec3,
+    /// What rays above the horizon read: the upper half's mirror extension (`r(w)` above the
+    /// horizon, `r(w')` below it, `w'` the mirror image of `w`), in the rays' bands.
+    above: RadianceSh,
+    /// What rays below the horizon read: the lower half's mirror extension.
+    below: RadianceSh,
+    /// The upper half alone (zero below the horizon): its irradiance is where the estimate
+    /// starts.
+    upper: Box<Ambient>,
+}
+
+/// How an occlusion ray enters the hybrid ambient's estimate ([`Ambient::ray_role`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RayRole {
+    /// The ray's radiance is taken off where the ray is blocked: the estimate starts from this
+    /// direction's light.
+    TakenOffWhereBlocked,
+    /// The ray's radiance is added where the ray is open: the estimate starts without it.
+    AddedWhereOpen,
+}
+
+/// The ambient of the three parts of [`horizon_halves`], probe frame.
+#[derive(Clone, Debug)]
+pub struct HorizonResidual {
+    /// The upper half's mirror extension.
+    pub above: RadianceSh,
+    /// The lower half's mirror extension.
+    pub below: RadianceSh,
+    /// The upper half, zero below the horizon.
+    pub upper: RadianceSh,
 }
 
 impl Ambient {
@@ -177,6 +234,41 @@ impl Ambient {
             sh,
             finer,
             occlusion_rays: occlusion_rays.max(1),
+            halves: None,
+        }
+    }
+
+    /// The same ambient split at the horizon plane of unit normal `up` (world frame; module
+    /// notes, "The ambient at the horizon"): `halves` ([`horizon_halves`], turned to the world
+    /// frame) say what the rays read on either side and where the estimate starts. The
+    /// irradiance of an open surface ([`Ambient::irradiance`]) is unchanged.
+    pub fn with_horizon_halves(mut self, up: Vec3, halves: &HorizonResidual) -> Ambient {
+        let bands = self.sh.bands();
+        self.halves = Some(HorizonHalves {
+            up,
+            above: halves.above.truncated(bands),
+            below: halves.below.truncated(bands),
+            upper: Box::new(Ambient::with_ray_bands(&halves.upper, bands, 1)),
+        });
+        self
+    }
+
+    /// How an occlusion ray in the unit world direction `dir` enters the estimate: without
+    /// halves every ray is [`RayRole::TakenOffWhereBlocked`]; with them, those below the
+    /// horizon are [`RayRole::AddedWhereOpen`].
+    pub fn ray_role(&self, dir: Vec3) -> RayRole {
+        match &self.halves {
+            Some(h) if dir.dot(h.up) < 0.0 => RayRole::AddedWhereOpen,
+            _ => RayRole::TakenOffWhereBlocked,
+        }
+    }
+
+    /// The irradiance (world frame, unit normal `n`) the estimate starts from: the ambient's
+    /// whole irradiance ([`Ambient::irradiance`]) without halves, its upper half's with them.
+    pub fn starting_irradiance(&self, n: Vec3) -> Rgb {
+        match &self.halves {
+            Some(h) => h.upper.irradiance(n),
+            None => self.irradiance(n),
         }
     }
 
@@ -188,7 +280,12 @@ impl Ambient {
     /// The ambient radiance arriving from the unit world direction `dir` (may be negative:
     /// the ambient is a difference). O(bands^2).
     pub fn radiance(&self, dir: Vec3) -> Rgb {
-        evaluate(self.sh.bands(), self.sh.coefficients(), dir)
+        let sh = match &self.halves {
+            Some(h) if dir.dot(h.up) < 0.0 => &h.below,
+            Some(h) => &h.above,
+            None => &self.sh,
+        };
+        evaluate(sh.bands(), sh.coefficients(), dir)
     }
 
     /// The ambient irradiance on an unoccluded surface of unit normal `n` (world frame; may be
@@ -348,12 +445,15 @@ impl Lighting {
             ShadowKind::Hard => full,
             ShadowKind::Soft => with_cones_spread(&full, set),
         };
+        let mut ambient =
+            Ambient::with_ray_bands(&full.rotated(rotation), ray_bands, occlusion_rays);
+        if let Some(halves) = horizon_halves(&scene.probe.radiance, set, shadows, ray_bands) {
+            let up = (rotation * DVec3::Y).normalize_or(DVec3::Y).as_vec3();
+            ambient = ambient.with_horizon_halves(up, &halves.rotated(rotation));
+        }
         Ok(Lighting {
             environment: Self::environment(scene)?,
-            illumination: Illumination::Hybrid(
-                light_list(scene, set, shadows),
-                Ambient::with_ray_bands(&full.rotated(rotation), ray_bands, occlusion_rays),
-            ),
+            illumination: Illumination::Hybrid(light_list(scene, set, shadows), ambient),
             luminaires: scene.luminaires.clone(),
         })
     }
@@ -389,6 +489,84 @@ fn with_finer_bands(probe: &Image<Rgb>, lights: &LightSet, ambient: &RadianceSh)
     );
     coefficients[..ambient.coefficients().len()].copy_from_slice(ambient.coefficients());
     RadianceSh::new(bands, coefficients).unwrap_or_else(|_| ambient.clone())
+}
+
+/// The probe less the lights (probe frame) split at the probe's horizon (module notes, "The
+/// ambient at the horizon"): each half's mirror extension in `ray_bands` bands and the upper half
+/// alone in [`MAX_AMBIENT_BANDS`]. A half of the probe is projected with the other half's rows
+/// zero or mirrored about the equator (exact on the lat-long grid; the middle row of an odd
+/// height counts as above, as `ibl_extract::hemispheres` takes it); each light is taken off as
+/// points, its direction with hard shadows and its soft-shadow cone points with soft ones
+/// ([`ibl_light::Light::soft_points`], folded onto its side where it has one), each point in
+/// the half of its light's side or else the half it lies in (the horizon counting as above),
+/// with its mirror image in a mirror extension. `None` where the probe cannot be projected.
+pub fn horizon_halves(
+    probe: &Image<Rgb>,
+    lights: &LightSet,
+    shadows: ShadowKind,
+    ray_bands: usize,
+) -> Option<HorizonResidual> {
+    let (w, h) = (probe.width(), probe.height());
+    let is_above = |j: usize| 2 * j < h;
+    let points: Vec<(HorizonSide, DVec3, [f64; 3])> = lights
+        .lights
+        .iter()
+        .flat_map(|light| {
+            let power = light.irradiance.to_array();
+            let points = match shadows {
+                ShadowKind::Hard => vec![(light.direction, 1.0)],
+                ShadowKind::Soft => light.soft_points(HALF_SH_POINTS_PER_CONE),
+            };
+            points.into_iter().map(move |(p, weight)| {
+                let side = light.side.unwrap_or(if p.y >= 0.0 {
+                    HorizonSide::Above
+                } else {
+                    HorizonSide::Below
+                });
+                (side, p, power.map(|v| v * weight))
+            })
+        })
+        .collect();
+    let part = |side: HorizonSide, mirrored: bool, bands: usize| -> Option<RadianceSh> {
+        let up = side.up();
+        let image = Image::from_fn_par(w, h, |i, j| {
+            if is_above(j) == (side == HorizonSide::Above) {
+                *probe.get(i, j)
+            } else if mirrored {
+                *probe.get(i, h - 1 - j)
+            } else {
+                Rgb::ZERO
+            }
+        });
+        let mut coefficients = project_latlong(&image, bands).ok()?.coefficients().to_vec();
+        let mine = points.iter().filter(|(s, _, _)| *s == side);
+        let taken = mine.flat_map(|&(_, p, value)| {
+            let mirror = p - 2.0 * p.dot(up) * up;
+            std::iter::once((p, value)).chain(mirrored.then_some((mirror, value)))
+        });
+        subtract_point_sources(&mut coefficients, bands, taken);
+        RadianceSh::new(bands, coefficients).ok()
+    };
+    Some(HorizonResidual {
+        above: part(HorizonSide::Above, true, ray_bands)?,
+        below: part(HorizonSide::Below, true, ray_bands)?,
+        upper: part(HorizonSide::Above, false, MAX_AMBIENT_BANDS)?,
+    })
+}
+
+/// Quadrature points per cone for the halves of [`horizon_halves`]: the rays' bands are at
+/// most 16, as for [`FOLDED_SH_POINTS_PER_CONE`].
+const HALF_SH_POINTS_PER_CONE: usize = 256;
+
+impl HorizonResidual {
+    /// The three parts turned by `rotation`.
+    pub fn rotated(&self, rotation: DMat3) -> HorizonResidual {
+        HorizonResidual {
+            above: self.above.rotated(rotation),
+            below: self.below.rotated(rotation),
+            upper: self.upper.rotated(rotation),
+        }
+    }
 }
 
 /// Quadrature points per cone for the SH of a light folded onto its side of the horizon

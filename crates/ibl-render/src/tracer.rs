@@ -56,7 +56,7 @@ use ibl_scene::bvh::OccluderHint;
 use ibl_scene::{Hit, Ray, Scene, ShadowKind, SurfacePoint};
 use rayon::prelude::*;
 
-use crate::lighting::{Ambient, Illumination, LightList, Lighting};
+use crate::lighting::{Ambient, Illumination, LightList, Lighting, RayRole};
 use crate::material::Bsdf;
 use crate::sampler::SampleStream;
 use crate::sampling::{LightShading, OrthonormalBasis, power_heuristic, sample_cosine_hemisphere};
@@ -728,12 +728,18 @@ impl<'a> Tracer<'a> {
         sum
     }
 
-    /// The hybrid ambient, `albedo E[V(w) L_a(w)]` over cosine-distributed `w`, with the
-    /// unoccluded part exact: `albedo (E_a(n) / pi - mean_k (1 - V(w_k)) L_a(w_k))`, `E_a` the
-    /// ambient's SH irradiance ([`Ambient::irradiance`]), since `E[L_a(w)] = E_a(n) / pi` under
-    /// the cosine density. The same expectation as `mean_k V(w_k) L_a(w_k)` (a control
-    /// variate), but where no occlusion ray is blocked there is no noise at all, and only the
-    /// blocked rays evaluate `L_a`. A direction below the geometric surface is blocked by it.
+    /// The hybrid ambient, `albedo E[V(w) L_a(w)]` over cosine-distributed `w`. Without halves
+    /// the unoccluded part is exact: `albedo (E_a(n) / pi - mean_k (1 - V(w_k)) L_a(w_k))`,
+    /// `E_a` the ambient's SH irradiance ([`Ambient::irradiance`]), since `E[L_a(w)] = E_a(n) /
+    /// pi` under the cosine density: the same expectation as `mean_k V(w_k) L_a(w_k)` (a
+    /// control variate), but where no occlusion ray is blocked there is no noise at all. Split
+    /// at the horizon (module notes of `lighting`, "The ambient at the horizon"), it starts from
+    /// the upper half's irradiance `E_up(n)` ([`Ambient::starting_irradiance`]), takes off what
+    /// blocked rays above the horizon read and adds what open rays below it read:
+    /// `albedo (E_up(n) / pi - mean_k [w_k up] (1 - V) L_up(w_k) + mean_k [w_k down] V
+    /// L_down(w_k))`, the same expectation again, and no noise where the sky is open and the
+    /// ground is closed. Only the rays that count evaluate `L_a`. A direction below the
+    /// geometric surface is blocked by it.
     fn ambient(
         &self,
         ambient: &Ambient,
@@ -748,8 +754,10 @@ impl<'a> Tracer<'a> {
         }
         let basis = OrthonormalBasis::from_normal(surface.shading_normal);
         let origin = above(surface);
-        // The ambient light the rays find blocked, in each layer.
+        // The ambient light the rays find blocked (rays whose light the estimate starts
+        // with) and open (rays whose light it starts without), in each layer.
         let mut hidden = none;
+        let mut found = none;
         for _ in 0..ambient.occlusion_rays {
             let [u1, u2] = stream.next_2d();
             let wi = basis.to_world(sample_cosine_hemisphere(u1, u2));
@@ -758,16 +766,23 @@ impl<'a> Tracer<'a> {
             } else {
                 Occlusion::Real
             };
-            if occlusion != Occlusion::Open {
-                hidden.add_blocked(occlusion, ambient.radiance(wi));
+            match ambient.ray_role(wi) {
+                RayRole::TakenOffWhereBlocked if occlusion != Occlusion::Open => {
+                    hidden.add_blocked(occlusion, ambient.radiance(wi));
+                }
+                RayRole::AddedWhereOpen if occlusion != Occlusion::Real => {
+                    found.add(occlusion, ambient.radiance(wi));
+                }
+                _ => {}
             }
         }
-        let open = ambient.irradiance(surface.shading_normal) * std::f32::consts::FRAC_1_PI;
+        let start =
+            ambient.starting_irradiance(surface.shading_normal) * std::f32::consts::FRAC_1_PI;
         let k = ambient.occlusion_rays as f32;
-        let light = |hidden: Rgb| albedo * (open - hidden / k);
+        let light = |hidden: Rgb, found: Rgb| albedo * (start + (found - hidden) / k);
         LayeredLight {
-            with: light(hidden.with),
-            without: hidden.without.map(light),
+            with: light(hidden.with, found.with),
+            without: hidden.without.zip(found.without).map(|(h, f)| light(h, f)),
         }
     }
 

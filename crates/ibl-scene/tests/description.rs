@@ -113,7 +113,7 @@ fn defaults_fill_what_is_left_out() {
     assert_eq!(d.render.composite, CompositeRule::Difference);
     let l = &d.lighting;
     assert_eq!((l.method.name(), l.lights), ("median-cut", 16));
-    assert_eq!((l.ambient_bands, l.ao_samples, l.spp), (5, 4, 4));
+    assert_eq!((l.ambient_bands, l.ao_samples, l.spp), (7, 4, 4));
     assert_eq!(l.shadows, ibl_scene::ShadowKind::Soft);
     assert_eq!(d.render.sampler, ibl_scene::SamplerKind::Sobol);
     assert!(l.lights_file.is_none());

@@ -45,9 +45,10 @@ pub struct LightingDescription {
     #[serde(default = "default_adaptive_contrast")]
     pub adaptive_contrast: f32,
     /// SH bands of the hybrid ambient that its occlusion rays read (a surface nothing occludes
-    /// gets 16). Default 5: the rays' bands 3 and 4 carry the lights' own error where an
-    /// occluder hides part of the sky (docs/RENDERING.md, "The hybrid's bands" and "The
-    /// ambient's two band counts").
+    /// gets 16). Default 7: the rays' bands 3 and 4 carry the lights' own error where an
+    /// occluder hides part of the sky, and with each side of the horizon read apart the bands
+    /// up to 6 pay too (docs/RENDERING.md, "The hybrid's bands", "The ambient's two band
+    /// counts" and "The ambient at the horizon").
     #[serde(default = "default_bands")]
     pub ambient_bands: u32,
     /// Occlusion rays per shading point and sample (hybrid). Default 4.
@@ -80,7 +81,7 @@ fn default_adaptive_contrast() -> f32 {
     0.02
 }
 fn default_bands() -> u32 {
-    5
+    7
 }
 fn default_ao() -> u32 {
     4
