@@ -97,6 +97,11 @@ pub enum HorizonSide {
 }
 
 impl HorizonSide {
+    /// `point` mirrored in the horizon plane (probe frame: `y -> -y`).
+    pub fn mirror(point: DVec3) -> DVec3 {
+        DVec3::new(point.x, -point.y, point.z)
+    }
+
     /// The unit normal of the horizon plane pointing into this side, probe frame.
     pub fn up(self) -> DVec3 {
         match self {

@@ -7,7 +7,7 @@
 
 use glam::DVec3;
 
-use crate::directional::Light;
+use crate::directional::{HorizonSide, Light};
 
 /// `count` points of the uniform cone of solid angle `solid_angle_sr` about unit `axis`, equal
 /// area each: a Fibonacci spiral over the spherical cap (point `k` at `1 - cos t = (k + 1/2) (1 -
@@ -62,9 +62,8 @@ impl Light {
         if let Some(side) = self.side {
             let up = side.up();
             for (p, _) in &mut points {
-                let height = p.dot(up);
-                if height < 0.0 {
-                    *p -= 2.0 * height * up;
+                if p.dot(up) < 0.0 {
+                    *p = HorizonSide::mirror(*p);
                 }
             }
         }

@@ -528,7 +528,6 @@ pub fn horizon_halves(
         })
         .collect();
     let part = |side: HorizonSide, mirrored: bool, bands: usize| -> Option<RadianceSh> {
-        let up = side.up();
         let image = Image::from_fn_par(w, h, |i, j| {
             if is_above(j) == (side == HorizonSide::Above) {
                 *probe.get(i, j)
@@ -541,8 +540,7 @@ pub fn horizon_halves(
         let mut coefficients = project_latlong(&image, bands).ok()?.coefficients().to_vec();
         let mine = points.iter().filter(|(s, _, _)| *s == side);
         let taken = mine.flat_map(|&(_, p, value)| {
-            let mirror = p - 2.0 * p.dot(up) * up;
-            std::iter::once((p, value)).chain(mirrored.then_some((mirror, value)))
+            std::iter::once((p, value)).chain(mirrored.then_some((HorizonSide::mirror(p), value)))
         });
         subtract_point_sources(&mut coefficients, bands, taken);
         RadianceSh::new(bands, coefficients).ok()
