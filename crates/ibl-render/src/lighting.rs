@@ -194,7 +194,7 @@ pub enum RayRole {
     AddedWhereOpen,
 }
 
-/// The ambient of the three parts of [`horizon_halves`], probe frame.
+/// The probe less the lights as [`horizon_halves`] splits it at the horizon, probe frame.
 #[derive(Clone, Debug)]
 pub struct HorizonResidual {
     /// The upper half's mirror extension.
@@ -277,8 +277,9 @@ impl Ambient {
         &self.sh
     }
 
-    /// The ambient radiance arriving from the unit world direction `dir` (may be negative:
-    /// the ambient is a difference). O(bands^2).
+    /// The ambient radiance the occlusion rays read from the unit world direction `dir` (may
+    /// be negative: the ambient is a difference): with halves, the mirror extension of the
+    /// half `dir` lies in ([`Ambient::with_horizon_halves`]). O(bands^2).
     pub fn radiance(&self, dir: Vec3) -> Rgb {
         let sh = match &self.halves {
             Some(h) if dir.dot(h.up) < 0.0 => &h.below,
