@@ -329,7 +329,7 @@ fn showcase(
         format!(
             "hybrid: {SHOWCASE_MODE_LIGHTS} median-cut lights (soft shadows) + SH{} ambient, \
              {} occlusion rays, {spp} spp",
-            hybrid_plan.ambient_bands * hybrid_plan.ambient_bands,
+            hybrid_plan.ray_bands().pow(2),
             hybrid_plan.occlusion_rays
         ),
         &hybrid.composite,
@@ -384,7 +384,9 @@ fn study(
         .filter_map(|m| match m {
             ModelSpec::Lights(source) => Some(ModelSpec::Hybrid {
                 lights: *source,
-                bands: base.ambient_bands,
+                bands: base
+                    .ambient_bands
+                    .resolve(lights_defaults.spp, base.occlusion_rays),
             }),
             _ => None,
         })

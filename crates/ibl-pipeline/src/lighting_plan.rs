@@ -18,7 +18,7 @@ use std::path::Path;
 use ibl_extract::{ExtractOptions, Hybrid, ModelSpec, build_model};
 use ibl_light::{LightSet, LightSource, Method};
 use ibl_render::Lighting;
-use ibl_scene::{RenderMode, Scene, ShadowKind};
+use ibl_scene::{AmbientBands, RenderMode, Scene, ShadowKind};
 use ibl_sh::Window;
 
 use crate::error::{Context, PipelineError, Result};
@@ -37,10 +37,13 @@ pub struct LightingPlan {
     pub given: Option<LightSet>,
     /// Hard or soft shadows.
     pub shadows: ShadowKind,
-    /// SH bands of the hybrid ambient.
-    pub ambient_bands: usize,
+    /// SH bands the hybrid ambient's occlusion rays read ([`LightingPlan::ray_bands`]).
+    pub ambient_bands: AmbientBands,
     /// Occlusion rays per shading point of the hybrid ambient.
     pub occlusion_rays: u32,
+    /// Samples per pixel of the render the lighting is for: with `ambient_bands` `auto`, the
+    /// rays' bands follow the rays a pixel traces.
+    pub samples_per_pixel: u32,
     /// Seed of the extraction (clustering restarts).
     pub seed: u64,
 }
@@ -56,8 +59,9 @@ impl LightingPlan {
             lights: l.lights as usize,
             given: None,
             shadows: l.shadows,
-            ambient_bands: l.ambient_bands as usize,
+            ambient_bands: l.ambient_bands,
             occlusion_rays: l.ao_samples,
+            samples_per_pixel: l.spp,
             seed: scene.render.seed,
         }
     }
@@ -87,6 +91,13 @@ impl LightingPlan {
         })
     }
 
+    /// The SH bands the hybrid ambient's occlusion rays read: `ambient_bands` resolved for
+    /// `samples_per_pixel` samples of `occlusion_rays` rays ([`AmbientBands::resolve`]).
+    pub fn ray_bands(&self) -> usize {
+        self.ambient_bands
+            .resolve(self.samples_per_pixel, self.occlusion_rays)
+    }
+
     /// Builds the lighting; also returns the light set used (none for the reference).
     /// Extraction runs on the scene's probe (radiance scale applied), in the probe frame.
     pub fn build(&self, scene: &Scene) -> Result<(Lighting, Option<LightSet>)> {
@@ -111,7 +122,7 @@ impl LightingPlan {
                 let hybrid = Hybrid::from_probe(
                     &scene.probe.radiance,
                     set.clone(),
-                    self.ambient_bands,
+                    self.ray_bands(),
                     Window::None,
                 )
                 .context("the hybrid ambient")?;

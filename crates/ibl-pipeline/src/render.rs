@@ -88,6 +88,21 @@ pub struct LightsSummary {
     pub count: usize,
     /// `hard` or `soft`.
     pub shadows: &'static str,
+    /// Hybrid mode: the SH bands the ambient's occlusion rays read and the rays per sample
+    /// (`None` in the lights mode).
+    pub ambient: Option<AmbientSummary>,
+}
+
+/// The hybrid ambient of a render in its summary.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct AmbientSummary {
+    /// SH bands the occlusion rays read (`[lighting] ambient_bands` resolved for the render's
+    /// samples per pixel).
+    pub ray_bands: usize,
+    /// `auto` or the scene's fixed count.
+    pub ambient_bands: String,
+    /// Occlusion rays per shading point and sample.
+    pub occlusion_rays: u32,
 }
 
 /// What a render did (the JSON of `ibl render --json`).
@@ -151,7 +166,13 @@ impl std::fmt::Display for RenderSummary {
             None => format!("{} spp", self.spp),
         };
         let lights = self.lights.as_ref().map_or(String::new(), |l| {
-            format!(" ({} lights, {} shadows)", l.count, l.shadows)
+            let ambient = l.ambient.as_ref().map_or(String::new(), |a| {
+                format!(
+                    ", ambient read in {} bands by {} rays a sample",
+                    a.ray_bands, a.occlusion_rays
+                )
+            });
+            format!(" ({} lights, {} shadows{ambient})", l.count, l.shadows)
         });
         write!(
             f,
@@ -219,6 +240,7 @@ pub fn render_scene(job: &RenderJob, progress: &dyn Progress) -> Result<RenderSu
         ..defaults
     };
     check_settings(&settings)?;
+    plan.samples_per_pixel = settings.spp;
 
     let started = Instant::now();
     let (lighting, set) = plan
@@ -246,6 +268,11 @@ pub fn render_scene(job: &RenderJob, progress: &dyn Progress) -> Result<RenderSu
             ),
             count: s.lights.len(),
             shadows: plan.shadows.name(),
+            ambient: (plan.mode == RenderMode::Hybrid).then(|| AmbientSummary {
+                ray_bands: plan.ray_bands(),
+                ambient_bands: plan.ambient_bands.name(),
+                occlusion_rays: plan.occlusion_rays,
+            }),
         }),
         width: stats.width,
         height: stats.height,

@@ -28,7 +28,7 @@
 //! clamped at 0 per channel.
 //!
 //! **The ambient's two band counts.** The occlusion rays read the ambient in the scene's
-//! `ambient_bands` (7), but a surface nothing occludes gets its irradiance in
+//! `ambient_bands` (`auto`: 3 to 7, below), but a surface nothing occludes gets its irradiance in
 //! [`MAX_AMBIENT_BANDS`] (16): the probe less the lights is carried on to 16 bands
 //! (`with_finer_bands`: the probe projected again, the lights taken off as points), and the
 //! irradiance of the bands above the rays' is tabulated over normals ([`NormalTable`]). So on an
@@ -59,6 +59,17 @@
 //! band read where it converges; with the jump gone, bands up to 6 pay for the rays
 //! (`ambient_bands` 5 -> 7; converged, on the render study's two scenes, every method's hybrid
 //! as good as before or better, BENCHMARKS.md "The ambient at the horizon").
+//!
+//! **How many bands the rays read.** More bands carry more of what the lights miss where an
+//! occluder hides part of the sky, but make each ray read a rougher function, so a pixel's
+//! few rays scatter more: a bias traded for noise, whose best count depends on the rays a pixel
+//! traces. Measured on the render study's two scenes, it grows by about one band each time they
+//! double (3 bands at 4 samples of 4 rays, 5 at 16 samples, 7 at 64, nothing more beyond 7 at
+//! 256), so `ambient_bands = "auto"` (the default, `ibl_scene::AmbientBands::resolve`) gives
+//! `log2(spp rays) - 1` within 3..=7. The rays of one vertex are drawn stratified together
+//! (`SampleStream::pairs`: one scrambled Sobol net across the pixel's samples and rays, not one
+//! net per ray), which lowers their noise at equal rays (docs/RENDERING.md, "How many bands
+//! the rays read").
 //!
 //! **Goniometric lights** (Grosch 2005 section 4.2, new light sources): in every mode the
 //! lighting may also hold point lights with measured intensity distributions
@@ -147,7 +158,7 @@ pub struct LightList {
 }
 
 /// Largest SH band count of the hybrid ambient (`[lighting] ambient_bands`).
-pub const MAX_AMBIENT_BANDS: usize = 16;
+pub const MAX_AMBIENT_BANDS: usize = ibl_scene::description::MAX_AMBIENT_BANDS as usize;
 
 /// The ambient of the `hybrid` mode: an SH radiance, world frame, seen through occlusion rays.
 #[derive(Clone, Debug)]

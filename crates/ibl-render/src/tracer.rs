@@ -758,8 +758,8 @@ impl<'a> Tracer<'a> {
         // with) and open (rays whose light it starts without), in each layer.
         let mut hidden = none;
         let mut found = none;
-        for _ in 0..ambient.occlusion_rays {
-            let [u1, u2] = stream.next_2d();
+        // The rays of one vertex are stratified together (`SampleStream::pairs`).
+        for [u1, u2] in stream.pairs(ambient.occlusion_rays) {
             let wi = basis.to_world(sample_cosine_hemisphere(u1, u2));
             let occlusion = if surface.geometric_normal.dot(wi) > 0.0 {
                 self.occlusion(origin, wi, state)

@@ -30,7 +30,8 @@ pub mod scene;
 pub use bvh::Bvh;
 pub use camera::Camera;
 pub use description::{
-    DescriptionError, FORMAT_VERSION, RenderMode, SamplerKind, SceneDescription, ShadowKind,
+    AmbientBands, DescriptionError, FORMAT_VERSION, RenderMode, SamplerKind, SceneDescription,
+    ShadowKind,
 };
 pub use material::Material;
 pub use mesh::{MeshError, TriangleMesh};

@@ -113,10 +113,55 @@ fn defaults_fill_what_is_left_out() {
     assert_eq!(d.render.composite, CompositeRule::Difference);
     let l = &d.lighting;
     assert_eq!((l.method.name(), l.lights), ("median-cut", 16));
-    assert_eq!((l.ambient_bands, l.ao_samples, l.spp), (7, 4, 4));
+    assert_eq!(
+        (l.ambient_bands, l.ao_samples, l.spp),
+        (ibl_scene::AmbientBands::Auto, 4, 4)
+    );
     assert_eq!(l.shadows, ibl_scene::ShadowKind::Soft);
     assert_eq!(d.render.sampler, ibl_scene::SamplerKind::Sobol);
     assert!(l.lights_file.is_none());
+}
+
+#[test]
+fn ambient_bands_are_auto_or_a_count() {
+    use ibl_scene::AmbientBands;
+    let bands = |value: &str| {
+        SceneDescription::from_toml(&format!("{BASE}[lighting]\nambient_bands = {value}\n"))
+            .unwrap()
+            .lighting
+            .ambient_bands
+    };
+    assert_eq!(bands("\"auto\""), AmbientBands::Auto);
+    assert_eq!(bands("\"AUTO\""), AmbientBands::Auto);
+    assert_eq!(bands("5"), AmbientBands::Fixed(5));
+    // Auto: one band more each time a pixel's rays (samples x occlusion rays) double, from 3
+    // at 16 rays (the scenes' 4 samples of 4 rays) to 7 at 256 and beyond.
+    for (spp, rays, expected) in [
+        (1, 1, 3),
+        (4, 4, 3),
+        (8, 4, 4),
+        (16, 4, 5),
+        (32, 4, 6),
+        (64, 4, 7),
+        (4, 64, 7),
+        (1024, 4, 7),
+        (u32::MAX, u32::MAX, 7),
+        (0, 0, 3),
+    ] {
+        assert_eq!(
+            AmbientBands::Auto.resolve(spp, rays),
+            expected,
+            "{spp} spp x {rays} rays"
+        );
+    }
+    assert_eq!(AmbientBands::Fixed(9).resolve(4, 4), 9);
+    assert_eq!("auto".parse(), Ok(AmbientBands::Auto));
+    assert_eq!(" 12 ".parse(), Ok(AmbientBands::Fixed(12)));
+    assert!("0".parse::<AmbientBands>().is_err() && "17".parse::<AmbientBands>().is_err());
+    assert_eq!(
+        (AmbientBands::Auto.name(), AmbientBands::Fixed(3).name()),
+        ("auto".into(), "3".into())
+    );
 }
 
 #[test]
@@ -420,6 +465,16 @@ fn every_validation_rule_names_its_field() {
         &format!("{BASE}[lighting]\nambient_bands = 17\n"),
         "lighting.ambient_bands",
         "1..=16",
+    );
+    refused(
+        &format!("{BASE}[lighting]\nambient_bands = -3\n"),
+        "lighting.ambient_bands",
+        "1..=16",
+    );
+    refused(
+        &format!("{BASE}[lighting]\nambient_bands = \"seven\"\n"),
+        "lighting.ambient_bands",
+        "\"auto\" or a band count",
     );
     refused(
         "version = 1\n[probe]\nfile = \"p.exr\"\nradiance_scale = 0.0\n",

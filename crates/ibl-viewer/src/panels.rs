@@ -8,8 +8,10 @@ use eframe::egui;
 use ibl_core::tonemap::ToneCurve;
 use ibl_extract::ModelSpec;
 use ibl_light::{LightSource, Method};
-use ibl_scene::ShadowKind;
-use ibl_scene::description::{CompositeRule, MaterialDescription, MaterialKind, RenderMode};
+use ibl_scene::description::{
+    CompositeRule, LightingDescription, MaterialDescription, MaterialKind, RenderMode,
+};
+use ibl_scene::{AmbientBands, ShadowKind};
 
 use crate::probe_pass::{ProbeLayer, ProbeProjection};
 use crate::scene_renderer::GlossySource;
@@ -201,6 +203,32 @@ fn light_source_controls(ui: &mut egui::Ui, spec: &mut ModelSpec, lights: &mut u
     *lights = accepted_count(*spec, *lights);
 }
 
+/// The hybrid ambient's bands: `auto` (the count the scene's samples and occlusion rays give,
+/// shown on the slider) or a count of the user's.
+fn ambient_bands_row(ui: &mut egui::Ui, lighting: &mut LightingDescription) {
+    ui.horizontal(|ui| {
+        let mut auto = lighting.ambient_bands == AmbientBands::Auto;
+        let mut bands = lighting
+            .ambient_bands
+            .resolve(lighting.spp, lighting.ao_samples) as u32;
+        if ui
+            .checkbox(&mut auto, "auto bands")
+            .on_hover_text("the rays' bands from the samples and rays a pixel traces")
+            .changed()
+        {
+            lighting.ambient_bands = if auto {
+                AmbientBands::Auto
+            } else {
+                AmbientBands::Fixed(bands)
+            };
+        }
+        let slider = egui::Slider::new(&mut bands, 1..=8).text("ambient SH bands");
+        if ui.add_enabled(!auto, slider).changed() {
+            lighting.ambient_bands = AmbientBands::Fixed(bands);
+        }
+    });
+}
+
 fn scene_panel(ui: &mut egui::Ui, s: &mut SceneState, gpu_changed: &mut bool) {
     ui.heading("Scene");
     ui.label(s.model.path.display().to_string());
@@ -256,7 +284,7 @@ fn scene_panel(ui: &mut egui::Ui, s: &mut SceneState, gpu_changed: &mut bool) {
         );
     });
     if mode == RenderMode::Hybrid {
-        ui.add(egui::Slider::new(&mut d.lighting.ambient_bands, 1..=8).text("ambient SH bands"));
+        ambient_bands_row(ui, &mut d.lighting);
     }
     ui.horizontal(|ui| {
         ui.label("composite");

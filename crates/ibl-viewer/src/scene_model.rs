@@ -332,8 +332,9 @@ impl SceneModel {
             lights: l.lights as usize,
             given: self.given_lights.clone(),
             shadows: l.shadows,
-            ambient_bands: l.ambient_bands as usize,
+            ambient_bands: l.ambient_bands,
             occlusion_rays: l.ao_samples,
+            samples_per_pixel: l.spp,
             seed: self.description.render.seed,
         }
     }

@@ -15,6 +15,7 @@ use ibl_light::LightSource;
 use ibl_mapping::Mapping;
 use ibl_pipeline::Progress;
 use ibl_pipeline::room_input::{read_marks, read_room};
+use ibl_scene::AmbientBands;
 use serde::Serialize;
 
 use crate::gpu::AdapterSummary;
@@ -370,7 +371,7 @@ impl ViewJob {
             lighting.lights = n;
         }
         if let Some(b) = self.bands {
-            lighting.ambient_bands = check_bands(b)? as u32;
+            lighting.ambient_bands = AmbientBands::Fixed(check_bands(b)? as u32);
         }
         Ok(())
     }

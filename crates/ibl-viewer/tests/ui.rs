@@ -80,6 +80,18 @@ fn a_scene_opens_lights_arrive_and_the_panel_edits_it() {
         Content::Scene(s) => assert_eq!(s.model.description.render.mode, RenderMode::Hybrid),
         _ => panic!("a scene is open"),
     }
+    // The ambient's bands: the scene's `auto` (3 at its 4 samples of 4 rays) until the box is
+    // cleared, then the count the slider showed.
+    // (By accessibility action: the row may lie below the panel's visible part.)
+    h.get_by_label("auto bands").click_accesskit();
+    h.step();
+    match &h.state().content {
+        Content::Scene(s) => assert_eq!(
+            s.model.description.lighting.ambient_bands,
+            ibl_scene::AmbientBands::Fixed(3)
+        ),
+        _ => panic!("a scene is open"),
+    }
     // The worker recomputes the lights with the ambient; the frames keep coming meanwhile.
     step_until(&mut h, |app| match &app.content {
         Content::Scene(s) => s.lighting().is_some_and(|l| l.ambient.is_some()),

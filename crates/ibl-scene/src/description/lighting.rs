@@ -45,12 +45,10 @@ pub struct LightingDescription {
     #[serde(default = "default_adaptive_contrast")]
     pub adaptive_contrast: f32,
     /// SH bands of the hybrid ambient that its occlusion rays read (a surface nothing occludes
-    /// gets 16). Default 7: the rays' bands 3 and 4 carry the lights' own error where an
-    /// occluder hides part of the sky, and with each side of the horizon read apart the bands
-    /// up to 6 pay too (docs/RENDERING.md, "The hybrid's bands", "The ambient's two band
-    /// counts" and "The ambient at the horizon").
-    #[serde(default = "default_bands")]
-    pub ambient_bands: u32,
+    /// gets 16): a count in 1..=16, or `"auto"` (the default), which grows with the occlusion
+    /// rays a pixel traces ([`AmbientBands::resolve`]).
+    #[serde(default)]
+    pub ambient_bands: AmbientBands,
     /// Occlusion rays per shading point and sample (hybrid). Default 4.
     #[serde(default = "default_ao")]
     pub ao_samples: u32,
@@ -80,9 +78,6 @@ fn default_adaptive() -> bool {
 fn default_adaptive_contrast() -> f32 {
     0.02
 }
-fn default_bands() -> u32 {
-    7
-}
 fn default_ao() -> u32 {
     4
 }
@@ -97,8 +92,100 @@ impl Default for LightingDescription {
             spp: default_lights_spp(),
             adaptive: default_adaptive(),
             adaptive_contrast: default_adaptive_contrast(),
-            ambient_bands: default_bands(),
+            ambient_bands: AmbientBands::Auto,
             ao_samples: default_ao(),
+        }
+    }
+}
+
+/// Largest `ambient_bands` count.
+pub const MAX_AMBIENT_BANDS: u32 = 16;
+
+/// `[lighting] ambient_bands`: how many SH bands of the hybrid ambient its occlusion rays read.
+///
+/// The rays' bands trade bias for noise. More bands carry more of what the lights miss where an
+/// occluder hides part of the sky (less bias), but each ray reads a rougher function, so a
+/// pixel's few rays scatter more (more noise). Measured on the render study's two scenes
+/// (docs/RENDERING.md, "How many bands the rays read"), the best count grows by about one band
+/// each time a pixel's occlusion rays double: 3 bands at 4 samples of 4 rays, 5 at 16
+/// samples, 7 at 64, and no better beyond 7 at 256.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum AmbientBands {
+    /// Chosen from the rays a pixel traces ([`AmbientBands::resolve`]).
+    #[default]
+    Auto,
+    /// This many bands, in 1..=[`MAX_AMBIENT_BANDS`].
+    Fixed(u32),
+}
+
+/// Fewest and most bands [`AmbientBands::Auto`] gives.
+pub const AUTO_AMBIENT_BANDS: std::ops::RangeInclusive<u32> = 3..=7;
+
+impl AmbientBands {
+    /// The bands the rays read in a render of `spp` samples per pixel with `rays` occlusion
+    /// rays per sample: a fixed count as it is; `Auto` gives `log2(spp rays) - 1` rounded down
+    /// (one band more each time the pixel's rays double), within [`AUTO_AMBIENT_BANDS`].
+    pub fn resolve(self, spp: u32, rays: u32) -> usize {
+        match self {
+            AmbientBands::Fixed(bands) => bands as usize,
+            AmbientBands::Auto => {
+                let pixel_rays = u64::from(spp.max(1)) * u64::from(rays.max(1));
+                let bands = pixel_rays.ilog2().saturating_sub(1);
+                bands.clamp(*AUTO_AMBIENT_BANDS.start(), *AUTO_AMBIENT_BANDS.end()) as usize
+            }
+        }
+    }
+
+    /// `auto` or the count, as files and the command line write it.
+    pub fn name(self) -> String {
+        match self {
+            AmbientBands::Auto => "auto".to_owned(),
+            AmbientBands::Fixed(bands) => bands.to_string(),
+        }
+    }
+}
+
+impl std::str::FromStr for AmbientBands {
+    type Err = String;
+
+    /// `auto` or a count in 1..=[`MAX_AMBIENT_BANDS`].
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        if s.trim().eq_ignore_ascii_case("auto") {
+            return Ok(AmbientBands::Auto);
+        }
+        match s.trim().parse::<u32>() {
+            Ok(bands) if (1..=MAX_AMBIENT_BANDS).contains(&bands) => Ok(AmbientBands::Fixed(bands)),
+            _ => Err(format!(
+                "'{s}' is not \"auto\" or a band count in 1..={MAX_AMBIENT_BANDS}"
+            )),
+        }
+    }
+}
+
+impl Serialize for AmbientBands {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        match self {
+            AmbientBands::Auto => s.serialize_str("auto"),
+            AmbientBands::Fixed(bands) => s.serialize_u32(*bands),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for AmbientBands {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        /// What a file may hold: a count or a word.
+        #[derive(Deserialize)]
+        #[serde(untagged)]
+        enum Written {
+            Count(i64),
+            Word(String),
+        }
+        match Written::deserialize(d)? {
+            // The range is checked with the description's other counts (`validate`).
+            Written::Count(n) => u32::try_from(n).map(AmbientBands::Fixed).map_err(|_| {
+                serde::de::Error::custom(format!("{n} is not in 1..={MAX_AMBIENT_BANDS}"))
+            }),
+            Written::Word(word) => word.parse().map_err(serde::de::Error::custom),
         }
     }
 }
@@ -145,10 +232,12 @@ impl LightingDescription {
                 format!("{} is not in (0, 1]", self.adaptive_contrast),
             ));
         }
-        if !(1..=16).contains(&self.ambient_bands) {
+        if let AmbientBands::Fixed(bands) = self.ambient_bands
+            && !(1..=MAX_AMBIENT_BANDS).contains(&bands)
+        {
             return Err(invalid(
                 "lighting.ambient_bands",
-                format!("{} is not in 1..=16", self.ambient_bands),
+                format!("{bands} is not in 1..={MAX_AMBIENT_BANDS} (or \"auto\")"),
             ));
         }
         if !(1..=1024).contains(&self.ao_samples) {

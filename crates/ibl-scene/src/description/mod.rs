@@ -46,7 +46,9 @@ pub use geometry::{
     GeometryDescription, MAX_SCENE_TRIANGLES, SPHERE_SUBDIVISIONS, Scale, ShapeKind,
     shape_triangles,
 };
-pub use lighting::{LightingDescription, ShadowKind};
+pub use lighting::{
+    AUTO_AMBIENT_BANDS, AmbientBands, LightingDescription, MAX_AMBIENT_BANDS, ShadowKind,
+};
 pub use luminaire::{IntensityScale, LuminaireDescription, MAX_LUMINAIRES, validate_luminaires};
 pub use material::{
     DEFAULT_ALBEDO, DEFAULT_EXPONENT, DEFAULT_MIRROR, DEFAULT_SPECULAR, MaterialDescription,
