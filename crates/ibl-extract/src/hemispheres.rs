@@ -79,6 +79,7 @@ use crate::irradiance_optimization::{
     Fit, LightDomain, OptimizationOptions, check_light_count, fit_irradiance_in, fit_normals, gram,
 };
 use crate::light_cells::{aim_cores_at_their_centroids, size_by_cells};
+use crate::region_stats::Grid;
 use crate::{ExtractError, irradiance_optimization, nnls_gram};
 
 /// Irradiance optimisation of `probe` (lat-long, world frame) into exactly `n` lights (1 to
@@ -94,7 +95,7 @@ pub fn fit_hemispheres(
     options: &OptimizationOptions,
 ) -> Result<Fit, ExtractError> {
     check_light_count(n)?;
-    let upper_rows = upper_rows(probe.height());
+    let upper_rows = HorizonSide::upper_rows(probe.height());
     let power = half_powers(probe, upper_rows);
     let total = power[0] + power[1];
     if n < 2 || !(total.is_finite() && total > 0.0) {
@@ -140,11 +141,12 @@ pub fn fit_hemispheres(
     }
     // Every light sized by its cell among all the lights (module `light_cells`), as the
     // whole-sphere fit's are.
-    size_by_cells(probe, &mut lights)?;
+    let grid = Grid::new(probe)?;
+    size_by_cells(probe, &grid, &mut lights);
     // Each concentrated source's light aimed at its core (module doc, "Cores at their
     // centroids"), and the cells sized again for the new directions.
-    if aim_cores_at_their_centroids(probe, &mut lights)? {
-        size_by_cells(probe, &mut lights)?;
+    if aim_cores_at_their_centroids(probe, &grid, &mut lights) {
+        size_by_cells(probe, &grid, &mut lights);
     }
     // Each half's powers solved again for its lights as soft shadows render them; the report
     // scores the halves' lights together as drawn.
@@ -261,12 +263,6 @@ fn scaled_errors(target: &[[f64; 3]], drawn: &[[f64; 3]]) -> (f64, f64) {
     )
 }
 
-/// The number of pixel rows of the upper half of a lat-long probe `h` rows high: the rows whose
-/// centre lies above the horizon, and the middle row of an odd height (its centre on it).
-fn upper_rows(h: usize) -> usize {
-    h.div_ceil(2)
-}
-
 /// Luminance power (sum of luminance times pixel solid angle; negative and non-finite values
 /// count as 0) of rows `0..upper` and of the rest. An image without pixels has none.
 fn half_powers(probe: &Image<Rgb>, upper: usize) -> [f64; 2] {
@@ -312,14 +308,6 @@ fn only_rows(probe: &Image<Rgb>, rows: std::ops::Range<usize>) -> Image<Rgb> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn the_horizon_splits_the_rows_at_their_centres() {
-        // Even heights: half the rows; odd: the middle row (centre on the horizon) goes up.
-        assert_eq!(upper_rows(256), 128);
-        assert_eq!(upper_rows(5), 3);
-        assert_eq!(upper_rows(1), 1);
-    }
 
     #[test]
     fn lights_are_shared_by_power_with_one_at_least_per_lit_half() {

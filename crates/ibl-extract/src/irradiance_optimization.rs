@@ -225,7 +225,8 @@ pub fn irradiance_optimization(
     let mut fit = fit_irradiance(normals, target, n, options)?;
     // Each light sized by the probe's pixels nearest it (module `light_cells`): its soft shadow
     // is its cell's, not the fit's 1-degree disc.
-    crate::light_cells::size_by_cells(probe, &mut fit.set.lights)?;
+    let grid = crate::region_stats::Grid::new(probe)?;
+    crate::light_cells::size_by_cells(probe, &grid, &mut fit.set.lights);
     Ok(fit)
 }
 

@@ -46,7 +46,6 @@ use ibl_light::Light;
 use ibl_light::spread::{SpreadHistogram, WIDEST_CORE_IN_A_CLUSTER};
 use rayon::prelude::*;
 
-use crate::ExtractError;
 use crate::region_stats::{Grid, core_fraction, each_pixel, light};
 
 /// Side of a tile, pixels.
@@ -92,16 +91,15 @@ impl RowCells {
 /// sets its `solid_angle_sr` to the cell's, its radiance to `I / Omega_cell`, its spread and its
 /// core fraction. A light whose cell holds no pixel, or no energy, keeps its solid angle and gets
 /// no spread. Directions need not be unit (they are normalised for the search; a zero or
-/// non-finite direction gets no cell). Cost: module doc.
-pub(crate) fn size_by_cells(probe: &Image<Rgb>, lights: &mut [Light]) -> Result<(), ExtractError> {
+/// non-finite direction gets no cell). `grid` is `probe`'s ([`Grid::new`]). Cost: module doc.
+pub(crate) fn size_by_cells(probe: &Image<Rgb>, grid: &Grid, lights: &mut [Light]) {
     let dirs: Vec<Option<DVec3>> = lights.iter().map(|l| l.direction.try_normalize()).collect();
     if dirs.iter().all(Option::is_none) {
-        return Ok(());
+        return;
     }
-    let grid = Grid::new(probe)?;
     let tile_rows: Vec<RowCells> = (0..grid.h.div_ceil(TILE))
         .into_par_iter()
-        .map(|t| tile_row(probe, &grid, &dirs, t))
+        .map(|t| tile_row(probe, grid, &dirs, t))
         .collect();
     let mut cells = vec![Cell::default(); lights.len()];
     for row in &tile_rows {
@@ -125,7 +123,6 @@ pub(crate) fn size_by_cells(probe: &Image<Rgb>, lights: &mut [Light]) -> Result<
             l.side = side;
         }
     }
-    Ok(())
 }
 
 /// Aims each of `lights` that has a core and a halo (a concentrated source inside its cell, such
@@ -136,15 +133,15 @@ pub(crate) fn size_by_cells(probe: &Image<Rgb>, lights: &mut [Light]) -> Result<
 /// where its source is: on the sky probe, 256 fitted lights split the sun between two lights 1
 /// degree apart, each with a 0.4-degree core, so the sun's shadow was two discs side by side
 /// (module doc, "Cores at their centroids"). Returns whether any light moved; the caller sizes
-/// the cells again. Directions need not be unit. Only the rows within the core's angle of the
+/// the cells again. Directions need not be unit; `grid` is `probe`'s. Only the rows within the core's angle of the
 /// light are read, O(W (rows in reach) N) for the core's pixels' nearest-light test; lights in
 /// parallel, each summed in pixel order (results do not depend on the thread count).
 pub(crate) fn aim_cores_at_their_centroids(
     probe: &Image<Rgb>,
+    grid: &Grid,
     lights: &mut [Light],
-) -> Result<bool, ExtractError> {
+) -> bool {
     let dirs: Vec<Option<DVec3>> = lights.iter().map(|l| l.direction.try_normalize()).collect();
-    let grid = Grid::new(probe)?;
     let aims: Vec<Option<DVec3>> = lights
         .par_iter()
         .enumerate()
@@ -154,7 +151,7 @@ pub(crate) fn aim_cores_at_their_centroids(
             if !(l.core_fraction? < 1.0 && spread > 0.0) {
                 return None;
             }
-            let core = core_centroid(probe, &grid, &dirs, k, d, spread)?;
+            let core = core_centroid(probe, grid, &dirs, k, d, spread)?;
             let aim = match l.side {
                 Some(side) if core.dot(side.up()) < 0.0 => {
                     (core - core.dot(side.up()) * side.up()).try_normalize()?
@@ -171,7 +168,7 @@ pub(crate) fn aim_cores_at_their_centroids(
             moved = true;
         }
     }
-    Ok(moved)
+    moved
 }
 
 /// The unit energy centroid of the pixels of light `k`'s cell (nearest light `k` among `dirs`,
@@ -329,7 +326,7 @@ mod tests {
         let img = probe(200, 100, |_, _| 1.0);
         let dirs = ibl_core::fibonacci_normals(300);
         let mut lights: Vec<Light> = dirs.iter().map(|d| light(*d)).collect();
-        size_by_cells(&img, &mut lights).unwrap();
+        size_by_cells(&img, &Grid::new(&img).unwrap(), &mut lights);
         let grid = Grid::new(&img).unwrap();
         let expected = brute_force(&grid, &dirs);
         let mut total = 0.0;
@@ -352,7 +349,7 @@ mod tests {
         // plus the pixels' mean extent, to the histogram's 9 % (spread module doc).
         let img = probe(64, 32, |_, _| 1.0);
         let mut lights = vec![light(DVec3::Y), light(-DVec3::Y)];
-        size_by_cells(&img, &mut lights).unwrap();
+        size_by_cells(&img, &Grid::new(&img).unwrap(), &mut lights);
         for l in &lights {
             let two_pi = 2.0 * std::f64::consts::PI;
             assert!((l.solid_angle_sr - two_pi).abs() < 1e-9);
@@ -376,7 +373,7 @@ mod tests {
         });
         let grid = Grid::new(&img).unwrap();
         let mut lights = vec![light(grid.dir(64, 21))];
-        size_by_cells(&img, &mut lights).unwrap();
+        size_by_cells(&img, &Grid::new(&img).unwrap(), &mut lights);
         let l = &lights[0];
         assert!((l.solid_angle_sr - 4.0 * std::f64::consts::PI).abs() < 1e-9);
         let patch = 9.0 * grid.row_sr[21];
@@ -392,7 +389,7 @@ mod tests {
         let img = probe(32, 16, |_, _| 1.0);
         let mut lights = vec![light(DVec3::X), light(DVec3::X), light(DVec3::ZERO)];
         let before = lights.clone();
-        size_by_cells(&img, &mut lights).unwrap();
+        size_by_cells(&img, &Grid::new(&img).unwrap(), &mut lights);
         assert!((lights[0].solid_angle_sr - 4.0 * std::f64::consts::PI).abs() < 1e-9);
         assert_eq!(lights[1], before[1]);
         assert_eq!(lights[2], before[2]);
@@ -424,7 +421,11 @@ mod tests {
         };
         let far = light(-centre);
         let mut lights = vec![cored(off, Some(0.9)), cored(off, None), far];
-        assert!(aim_cores_at_their_centroids(&img, &mut lights).unwrap());
+        assert!(aim_cores_at_their_centroids(
+            &img,
+            &Grid::new(&img).unwrap(),
+            &mut lights
+        ));
         let moved = lights[0]
             .direction
             .dot(centre)
@@ -447,7 +448,7 @@ mod tests {
             spread_sr: Some(4.0),
             ..cored(start, Some(0.5))
         }];
-        aim_cores_at_their_centroids(&img, &mut lights).unwrap();
+        aim_cores_at_their_centroids(&img, &Grid::new(&img).unwrap(), &mut lights);
         let d = lights[0].direction;
         assert!(d.y.abs() < 1e-12 && (d.length() - 1.0).abs() < 1e-12, "{d}");
     }

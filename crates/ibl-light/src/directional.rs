@@ -97,6 +97,22 @@ pub enum HorizonSide {
 }
 
 impl HorizonSide {
+    /// The side a unit direction lies on (probe frame; the horizon itself counts as above).
+    pub fn of_direction(direction: DVec3) -> HorizonSide {
+        if direction.y >= 0.0 {
+            HorizonSide::Above
+        } else {
+            HorizonSide::Below
+        }
+    }
+
+    /// The number of pixel rows of the upper half of a lat-long image `height` rows high: the
+    /// rows whose centre lies above the horizon, and the middle row of an odd height (its
+    /// centre on it). Rows `0..upper_rows(h)` are above, the rest below.
+    pub fn upper_rows(height: usize) -> usize {
+        height.div_ceil(2)
+    }
+
     /// `point` mirrored in the horizon plane (probe frame: `y -> -y`).
     pub fn mirror(point: DVec3) -> DVec3 {
         DVec3::new(point.x, -point.y, point.z)
@@ -221,6 +237,19 @@ impl LightSet {
 mod tests {
     use super::*;
     use crate::{Extraction, Provenance};
+
+    #[test]
+    fn the_horizon_splits_the_rows_at_their_centres_and_directions_at_y_0() {
+        // Even heights: half the rows; odd: the middle row (centre on the horizon) goes up.
+        assert_eq!(HorizonSide::upper_rows(256), 128);
+        assert_eq!(HorizonSide::upper_rows(5), 3);
+        assert_eq!(HorizonSide::upper_rows(1), 1);
+        assert_eq!(HorizonSide::of_direction(DVec3::X), HorizonSide::Above);
+        assert_eq!(
+            HorizonSide::of_direction(DVec3::new(0.0, -1e-9, 1.0)),
+            HorizonSide::Below
+        );
+    }
 
     fn set() -> LightSet {
         LightSet {

@@ -519,7 +519,7 @@ pub fn horizon_halves(
     ray_bands: usize,
 ) -> Option<HorizonResidual> {
     let (w, h) = (probe.width(), probe.height());
-    let is_above = |j: usize| 2 * j < h;
+    let upper_rows = HorizonSide::upper_rows(h);
     let points: Vec<(HorizonSide, DVec3, [f64; 3])> = lights
         .lights
         .iter()
@@ -527,21 +527,17 @@ pub fn horizon_halves(
             let power = light.irradiance.to_array();
             let points = match shadows {
                 ShadowKind::Hard => vec![(light.direction, 1.0)],
-                ShadowKind::Soft => light.soft_points(HALF_SH_POINTS_PER_CONE),
+                ShadowKind::Soft => light.soft_points(SH_POINTS_PER_CONE),
             };
             points.into_iter().map(move |(p, weight)| {
-                let side = light.side.unwrap_or(if p.y >= 0.0 {
-                    HorizonSide::Above
-                } else {
-                    HorizonSide::Below
-                });
+                let side = light.side.unwrap_or(HorizonSide::of_direction(p));
                 (side, p, power.map(|v| v * weight))
             })
         })
         .collect();
     let part = |side: HorizonSide, mirrored: bool, bands: usize| -> Option<RadianceSh> {
         let image = Image::from_fn_par(w, h, |i, j| {
-            if is_above(j) == (side == HorizonSide::Above) {
+            if (j < upper_rows) == (side == HorizonSide::Above) {
                 *probe.get(i, j)
             } else if mirrored {
                 *probe.get(i, h - 1 - j)
@@ -564,10 +560,6 @@ pub fn horizon_halves(
     })
 }
 
-/// Quadrature points per cone for the halves of [`horizon_halves`]: the rays' bands are at
-/// most 16, as for [`FOLDED_SH_POINTS_PER_CONE`].
-const HALF_SH_POINTS_PER_CONE: usize = 256;
-
 impl HorizonResidual {
     /// The three parts turned by `rotation`.
     pub fn rotated(&self, rotation: DMat3) -> HorizonResidual {
@@ -579,10 +571,11 @@ impl HorizonResidual {
     }
 }
 
-/// Quadrature points per cone for the SH of a light folded onto its side of the horizon
-/// ([`ibl_light::Light::soft_points`]): spiral points about 3 degrees apart in a 30-degree cone,
-/// where band 15 varies over about 24 degrees.
-const FOLDED_SH_POINTS_PER_CONE: usize = 256;
+/// Quadrature points per cone for the SH of a light's soft-shadow cones taken as points (a
+/// light folded onto its side of the horizon, and the halves of [`horizon_halves`];
+/// [`ibl_light::Light::soft_points`]): spiral points about 3 degrees apart in a 30-degree cone,
+/// where band 15 (the most either reads) varies over about 24 degrees.
+const SH_POINTS_PER_CONE: usize = 256;
 
 /// `ambient + sum_i I_i (1 - g_l(c_i)) Y_lm(w_i)`: a point-subtracted ambient turned into the
 /// ambient of the same lights as uniform cones (module notes; a light with a halo as its two
@@ -597,7 +590,7 @@ fn with_cones_spread(ambient: &RadianceSh, lights: &LightSet) -> RadianceSh {
             // `Y(w) - sum_p w_p Y(p)` by quadrature over its folded cones.
             let power = [light.irradiance.r, light.irradiance.g, light.irradiance.b];
             let mut spread = basis(light.direction, bands);
-            for (p, w) in light.soft_points(FOLDED_SH_POINTS_PER_CONE) {
+            for (p, w) in light.soft_points(SH_POINTS_PER_CONE) {
                 for (s, y) in spread.iter_mut().zip(basis(p, bands)) {
                     *s -= w * y;
                 }
