@@ -164,8 +164,9 @@ fn lights_and_hybrid_modes_render_with_layers() {
     );
     let v = summary(&o, "lights", (48, 36));
     assert_eq!(v["lights"]["count"], 4);
-    // Soft shadows are the default (docs/SCENES.md).
+    // Soft shadows are the default (docs/SCENES.md); no ambient in the lights mode.
     assert_eq!(v["lights"]["shadows"], "soft");
+    assert!(v["lights"]["ambient"].is_null(), "{v}");
 
     let o = f.render(
         "scene.toml",
@@ -174,6 +175,37 @@ fn lights_and_hybrid_modes_render_with_layers() {
     );
     let v = summary(&o, "hybrid", (48, 36));
     assert_eq!(v["outputs"].as_array().unwrap().len(), 7);
+    // The ambient's bands: `auto` by default, 3 for these 2 samples of 4 rays (the fewest
+    // auto reads); given on the command line, the count and rays given.
+    let ambient = &v["lights"]["ambient"];
+    assert_eq!(
+        (
+            &ambient["ambient_bands"],
+            &ambient["ray_bands"],
+            &ambient["occlusion_rays"]
+        ),
+        (&Value::from("auto"), &Value::from(3), &Value::from(4))
+    );
+    let o = f.render(
+        "scene.toml",
+        "hybrid9.exr",
+        &[
+            &["--mode", "hybrid", "--ambient-bands", "9", "--ao-rays", "8"][..],
+            &lights,
+        ]
+        .concat(),
+    );
+    let v = summary(&o, "hybrid", (48, 36));
+    let ambient = &v["lights"]["ambient"];
+    assert_eq!(
+        (
+            &ambient["ambient_bands"],
+            &ambient["ray_bands"],
+            &ambient["occlusion_rays"]
+        ),
+        (&Value::from("9"), &Value::from(9), &Value::from(8))
+    );
+
     for layer in [
         "hybrid-with.exr",
         "hybrid-with.png",
@@ -340,6 +372,12 @@ fn bad_options_exit_2() {
         (&["--mode", "hybrid", "-n", "0"][..], "0 lights"),
         (&["--bounces", "0"][..], "--bounces"),
         (&["--panorama", "--mode", "bogus"][..], "bogus"),
+        (
+            &["--mode", "hybrid", "--ambient-bands", "17"][..],
+            "--ambient-bands",
+        ),
+        (&["--mode", "hybrid", "--ambient-bands", "most"][..], "auto"),
+        (&["--mode", "hybrid", "--ao-rays", "0"][..], "--ao-rays 0"),
     ] {
         let o = f.render("scene.toml", "bad.exr", extra);
         let err = stderr(&o);

@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use clap::{Args, ValueEnum};
 use ibl_light::LightSource;
 use ibl_pipeline::render::{Layers, RenderJob, View, render_scene};
-use ibl_scene::{RenderMode, SamplerKind, ShadowKind};
+use ibl_scene::{AmbientBands, RenderMode, SamplerKind, ShadowKind};
 
 use crate::progress::Bars;
 use crate::values;
@@ -61,6 +61,7 @@ Examples:
   ibl render assets/scenes/bunny-sky.toml -o b16.exr --mode lights -n 16 --method lightgen
   ibl render scene.toml -o b.exr --mode lights --lights lights.json --shadows soft
   ibl render scene.toml -o h.exr --mode hybrid --method sun -n 1 --spp 16 --json
+  ibl render scene.toml -o h.exr --mode hybrid --spp 64 --ambient-bands 9 --ao-rays 8
   ibl render scene.toml -o b.exr --width 640 --spp 256 --layers              + with/without/alpha
   ibl render scene.toml -o b.exr --sampler independent                       no low discrepancy
 
@@ -97,6 +98,15 @@ pub struct RenderArgs {
     /// Random numbers of the samples (default: the scene's `[render] sampler`, sobol).
     #[arg(long, value_enum)]
     pub sampler: Option<SamplerArg>,
+    /// SH bands the hybrid ambient's occlusion rays read: `auto` (from the samples and rays a
+    /// pixel traces: 3 at 4 samples of 4 rays, 5 at 16, 7 from 64) or a count in 1..=16
+    /// (default: the scene's `[lighting] ambient_bands`, auto).
+    #[arg(long, value_name = "auto|B", value_parser = str::parse::<AmbientBands>)]
+    pub ambient_bands: Option<AmbientBands>,
+    /// Occlusion rays per shading point and sample of the hybrid ambient (default: the scene's
+    /// `[lighting] ao_samples`, 4).
+    #[arg(long, value_name = "N")]
+    pub ao_rays: Option<u32>,
     /// Give every pixel all its samples in the lights and hybrid modes (default: the scene's
     /// `[lighting] adaptive`, on: one sample first, the rest only where neighbours differ).
     #[arg(long)]
@@ -140,6 +150,8 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
             SamplerArg::Sobol => SamplerKind::Sobol,
             SamplerArg::Independent => SamplerKind::Independent,
         }),
+        ambient_bands: args.ambient_bands,
+        occlusion_rays: args.ao_rays,
         no_adaptive: args.no_adaptive,
         width: args.width,
         bounces: args.bounces,

@@ -13,8 +13,8 @@ use ibl_core::{Image, Rgb};
 use ibl_io::WriteOptions;
 use ibl_light::LightSource;
 use ibl_render::{RenderOutput, RenderSettings, SamplerKind};
-use ibl_scene::description::{MAX_BOUNCES, MAX_SPP, MAX_WIDTH};
-use ibl_scene::{RenderMode, ShadowKind};
+use ibl_scene::description::{MAX_AMBIENT_BANDS, MAX_AO_SAMPLES, MAX_BOUNCES, MAX_SPP, MAX_WIDTH};
+use ibl_scene::{AmbientBands, RenderMode, ShadowKind};
 use serde::Serialize;
 
 use crate::envmap_files::check_output;
@@ -64,6 +64,10 @@ pub struct RenderJob {
     pub spp: Option<u32>,
     /// Random numbers of the samples.
     pub sampler: Option<SamplerKind>,
+    /// SH bands the hybrid ambient's occlusion rays read (`[lighting] ambient_bands`).
+    pub ambient_bands: Option<AmbientBands>,
+    /// Occlusion rays per shading point and sample of the hybrid (`[lighting] ao_samples`).
+    pub occlusion_rays: Option<u32>,
     /// Every pixel takes all its samples in the lights and hybrid modes (`false`: the scene's
     /// `[lighting] adaptive`, on by default).
     pub no_adaptive: bool,
@@ -219,6 +223,8 @@ pub fn render_scene(job: &RenderJob, progress: &dyn Progress) -> Result<RenderSu
     plan.lights = job.lights.unwrap_or(plan.lights);
     plan.shadows = job.shadows.unwrap_or(plan.shadows);
     plan.seed = job.seed.unwrap_or(plan.seed);
+    plan.ambient_bands = job.ambient_bands.unwrap_or(plan.ambient_bands);
+    plan.occlusion_rays = job.occlusion_rays.unwrap_or(plan.occlusion_rays);
     let lights_file = job.lights_file.clone().or(loaded.lights_path.clone());
     if let Some(path) = &lights_file {
         let scale = loaded.description.probe.radiance_scale;
@@ -240,6 +246,7 @@ pub fn render_scene(job: &RenderJob, progress: &dyn Progress) -> Result<RenderSu
         ..defaults
     };
     check_settings(&settings)?;
+    check_ambient(job)?;
     plan.samples_per_pixel = settings.spp;
 
     let started = Instant::now();
@@ -315,6 +322,25 @@ fn check_settings(s: &RenderSettings) -> Result<()> {
     {
         return Err(PipelineError::parameter(format!(
             "--width {w} is not in 2..={MAX_WIDTH}"
+        )));
+    }
+    Ok(())
+}
+
+/// The hybrid ambient's overrides against their ranges.
+fn check_ambient(job: &RenderJob) -> Result<()> {
+    if let Some(AmbientBands::Fixed(b)) = job.ambient_bands
+        && !(1..=MAX_AMBIENT_BANDS).contains(&b)
+    {
+        return Err(PipelineError::parameter(format!(
+            "--ambient-bands {b} is not in 1..={MAX_AMBIENT_BANDS} (or auto)"
+        )));
+    }
+    if let Some(r) = job.occlusion_rays
+        && !(1..=MAX_AO_SAMPLES).contains(&r)
+    {
+        return Err(PipelineError::parameter(format!(
+            "--ao-rays {r} is not in 1..={MAX_AO_SAMPLES}"
         )));
     }
     Ok(())

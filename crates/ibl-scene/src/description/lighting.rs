@@ -98,6 +98,9 @@ impl Default for LightingDescription {
     }
 }
 
+/// Most occlusion rays per shading point and sample (`ao_samples`).
+pub const MAX_AO_SAMPLES: u32 = 1024;
+
 /// Largest `ambient_bands` count.
 pub const MAX_AMBIENT_BANDS: u32 = 16;
 
@@ -240,10 +243,10 @@ impl LightingDescription {
                 format!("{bands} is not in 1..={MAX_AMBIENT_BANDS} (or \"auto\")"),
             ));
         }
-        if !(1..=1024).contains(&self.ao_samples) {
+        if !(1..=MAX_AO_SAMPLES).contains(&self.ao_samples) {
             return Err(invalid(
                 "lighting.ao_samples",
-                format!("{} is not in 1..=1024", self.ao_samples),
+                format!("{} is not in 1..={MAX_AO_SAMPLES}", self.ao_samples),
             ));
         }
         Ok(())

@@ -47,7 +47,8 @@ pub use geometry::{
     shape_triangles,
 };
 pub use lighting::{
-    AUTO_AMBIENT_BANDS, AmbientBands, LightingDescription, MAX_AMBIENT_BANDS, ShadowKind,
+    AUTO_AMBIENT_BANDS, AmbientBands, LightingDescription, MAX_AMBIENT_BANDS, MAX_AO_SAMPLES,
+    ShadowKind,
 };
 pub use luminaire::{IntensityScale, LuminaireDescription, MAX_LUMINAIRES, validate_luminaires};
 pub use material::{
