@@ -24,16 +24,6 @@ pub enum ModeArg {
     Hybrid,
 }
 
-impl From<ModeArg> for RenderMode {
-    fn from(m: ModeArg) -> Self {
-        match m {
-            ModeArg::Reference => RenderMode::Reference,
-            ModeArg::Lights => RenderMode::Lights,
-            ModeArg::Hybrid => RenderMode::Hybrid,
-        }
-    }
-}
-
 /// Shadow kinds on the command line.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum ShadowArg {
@@ -77,8 +67,7 @@ pub struct RenderArgs {
     /// Lighting mode (default: the scene's `[render] mode`).
     #[arg(long, value_enum)]
     pub mode: Option<ModeArg>,
-    /// Light file (`ibl lights ... -o lights.json`) for the lights and hybrid modes, instead of
-    /// extracting.
+    /// Light file (`ibl lights ... -o lights.json`) to use instead of extracting lights.
     #[arg(long, value_name = "FILE")]
     pub lights: Option<PathBuf>,
     /// Extraction method for lights/hybrid (median-cut, adaptive-median-cut, lightgen,
@@ -98,13 +87,11 @@ pub struct RenderArgs {
     /// Random numbers of the samples (default: the scene's `[render] sampler`, sobol).
     #[arg(long, value_enum)]
     pub sampler: Option<SamplerArg>,
-    /// SH bands the hybrid ambient's occlusion rays read: `auto` (from the samples and rays a
-    /// pixel traces: 3 at 4 samples of 4 rays, 5 at 16, 7 from 64) or a count in 1..=16
-    /// (default: the scene's `[lighting] ambient_bands`, auto).
+    /// SH bands the hybrid ambient's occlusion rays read: `auto` (3 at 4 samples of 4 rays, 5 at
+    /// 16, 7 from 64) or 1..=16 (default: the scene's `[lighting] ambient_bands`).
     #[arg(long, value_name = "auto|B", value_parser = str::parse::<AmbientBands>)]
     pub ambient_bands: Option<AmbientBands>,
-    /// Occlusion rays per shading point and sample of the hybrid ambient (default: the scene's
-    /// `[lighting] ao_samples`, 4).
+    /// Occlusion rays per shading point and sample (hybrid; default: `[lighting] ao_samples`).
     #[arg(long, value_name = "N")]
     pub ao_rays: Option<u32>,
     /// Give every pixel all its samples in the lights and hybrid modes (default: the scene's
@@ -120,8 +107,7 @@ pub struct RenderArgs {
     /// Random seed (the image depends on it only, not on the thread count).
     #[arg(long)]
     pub seed: Option<u64>,
-    /// Render the whole panorama seen from the probe's centre, ignoring the scene's `[camera]`
-    /// (panorama backgrounds only).
+    /// Render the whole panorama from the probe's centre, not the `[camera]` (panoramas only).
     #[arg(long)]
     pub panorama: bool,
     /// Also write the with/without-objects renders and the object coverage.
@@ -137,7 +123,11 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     let job = RenderJob {
         scene: args.scene.clone(),
         output: args.output.clone(),
-        mode: args.mode.map(RenderMode::from),
+        mode: args.mode.map(|m| match m {
+            ModeArg::Reference => RenderMode::Reference,
+            ModeArg::Lights => RenderMode::Lights,
+            ModeArg::Hybrid => RenderMode::Hybrid,
+        }),
         lights_file: args.lights.clone(),
         method: args.method,
         lights: args.n,
