@@ -175,17 +175,18 @@ fn lights_and_hybrid_modes_render_with_layers() {
     );
     let v = summary(&o, "hybrid", (48, 36));
     assert_eq!(v["outputs"].as_array().unwrap().len(), 7);
-    // The ambient's bands: `auto` by default, 3 for these 2 samples of 4 rays (the fewest
-    // auto reads); given on the command line, the count and rays given.
-    let ambient = &v["lights"]["ambient"];
-    assert_eq!(
+    // The ambient's bands as the summary reports them: given, read, and the rays per sample.
+    let ambient = |v: &Value| {
+        let a = &v["lights"]["ambient"];
         (
-            &ambient["ambient_bands"],
-            &ambient["ray_bands"],
-            &ambient["occlusion_rays"]
-        ),
-        (&Value::from("auto"), &Value::from(3), &Value::from(4))
-    );
+            a["ambient_bands"].clone(),
+            a["ray_bands"].clone(),
+            a["occlusion_rays"].clone(),
+        )
+    };
+    // `auto` by default, 3 for these 2 samples of 4 rays (the fewest auto reads); given on the
+    // command line, the count and rays given.
+    assert_eq!(ambient(&v), ("auto".into(), 3.into(), 4.into()));
     let o = f.render(
         "scene.toml",
         "hybrid9.exr",
@@ -196,15 +197,7 @@ fn lights_and_hybrid_modes_render_with_layers() {
         .concat(),
     );
     let v = summary(&o, "hybrid", (48, 36));
-    let ambient = &v["lights"]["ambient"];
-    assert_eq!(
-        (
-            &ambient["ambient_bands"],
-            &ambient["ray_bands"],
-            &ambient["occlusion_rays"]
-        ),
-        (&Value::from("9"), &Value::from(9), &Value::from(8))
-    );
+    assert_eq!(ambient(&v), ("9".into(), 9.into(), 8.into()));
 
     for layer in [
         "hybrid-with.exr",

@@ -191,7 +191,7 @@ fn timed_render(
     settings: &RenderSettings,
 ) -> Result<(RenderOutput, f64)> {
     let started = std::time::Instant::now();
-    let (lighting, _) = plan.build(scene)?;
+    let (lighting, _) = plan.build(scene, settings.spp)?;
     let output = render(scene, &lighting, settings, &|_, _| {})?;
     Ok((output, started.elapsed().as_secs_f64()))
 }
@@ -329,7 +329,7 @@ fn showcase(
         format!(
             "hybrid: {SHOWCASE_MODE_LIGHTS} median-cut lights (soft shadows) + SH{} ambient, \
              {} occlusion rays, {spp} spp",
-            hybrid_plan.ray_bands().pow(2),
+            hybrid_plan.ray_bands(spp).pow(2),
             hybrid_plan.occlusion_rays
         ),
         &hybrid.composite,
@@ -384,9 +384,7 @@ fn study(
         .filter_map(|m| match m {
             ModelSpec::Lights(source) => Some(ModelSpec::Hybrid {
                 lights: *source,
-                bands: base
-                    .ambient_bands
-                    .resolve(lights_defaults.spp, base.occlusion_rays),
+                bands: base.ray_bands(lights_defaults.spp),
             }),
             _ => None,
         })

@@ -41,9 +41,6 @@ pub struct LightingPlan {
     pub ambient_bands: AmbientBands,
     /// Occlusion rays per shading point of the hybrid ambient.
     pub occlusion_rays: u32,
-    /// Samples per pixel of the render the lighting is for: with `ambient_bands` `auto`, the
-    /// rays' bands follow the rays a pixel traces.
-    pub samples_per_pixel: u32,
     /// Seed of the extraction (clustering restarts).
     pub seed: u64,
 }
@@ -61,7 +58,6 @@ impl LightingPlan {
             shadows: l.shadows,
             ambient_bands: l.ambient_bands,
             occlusion_rays: l.ao_samples,
-            samples_per_pixel: l.spp,
             seed: scene.render.seed,
         }
     }
@@ -91,16 +87,17 @@ impl LightingPlan {
         })
     }
 
-    /// The SH bands the hybrid ambient's occlusion rays read: `ambient_bands` resolved for
-    /// `samples_per_pixel` samples of `occlusion_rays` rays ([`AmbientBands::resolve`]).
-    pub fn ray_bands(&self) -> usize {
-        self.ambient_bands
-            .resolve(self.samples_per_pixel, self.occlusion_rays)
+    /// The SH bands the hybrid ambient's occlusion rays read in a render of `spp` samples per
+    /// pixel: `ambient_bands` resolved for `spp` samples of `occlusion_rays` rays
+    /// ([`AmbientBands::resolve`]; with `auto` the bands follow the rays a pixel traces).
+    pub fn ray_bands(&self, spp: u32) -> usize {
+        self.ambient_bands.resolve(spp, self.occlusion_rays)
     }
 
-    /// Builds the lighting; also returns the light set used (none for the reference).
-    /// Extraction runs on the scene's probe (radiance scale applied), in the probe frame.
-    pub fn build(&self, scene: &Scene) -> Result<(Lighting, Option<LightSet>)> {
+    /// Builds the lighting of a render of `spp` samples per pixel; also returns the light set
+    /// used (none for the reference). Extraction runs on the scene's probe (radiance scale
+    /// applied), in the probe frame.
+    pub fn build(&self, scene: &Scene, spp: u32) -> Result<(Lighting, Option<LightSet>)> {
         if self.mode == RenderMode::Reference {
             return Ok((Lighting::reference(scene).map_err(render_error)?, None));
         }
@@ -122,7 +119,7 @@ impl LightingPlan {
                 let hybrid = Hybrid::from_probe(
                     &scene.probe.radiance,
                     set.clone(),
-                    self.ray_bands(),
+                    self.ray_bands(spp),
                     Window::None,
                 )
                 .context("the hybrid ambient")?;

@@ -13,7 +13,7 @@ use ibl_core::{Image, Rgb};
 use ibl_io::WriteOptions;
 use ibl_light::LightSource;
 use ibl_render::{RenderOutput, RenderSettings, SamplerKind};
-use ibl_scene::description::{MAX_AMBIENT_BANDS, MAX_AO_SAMPLES, MAX_BOUNCES, MAX_SPP, MAX_WIDTH};
+use ibl_scene::description::{MAX_BOUNCES, MAX_SPP, MAX_WIDTH, check_occlusion_rays};
 use ibl_scene::{AmbientBands, RenderMode, ShadowKind};
 use serde::Serialize;
 
@@ -247,11 +247,10 @@ pub fn render_scene(job: &RenderJob, progress: &dyn Progress) -> Result<RenderSu
     };
     check_settings(&settings)?;
     check_ambient(job)?;
-    plan.samples_per_pixel = settings.spp;
 
     let started = Instant::now();
     let (lighting, set) = plan
-        .build(scene)
+        .build(scene, settings.spp)
         .context(format!("{scene_name}: lighting"))?;
     let seconds_lighting = started.elapsed().as_secs_f64();
 
@@ -276,7 +275,7 @@ pub fn render_scene(job: &RenderJob, progress: &dyn Progress) -> Result<RenderSu
             count: s.lights.len(),
             shadows: plan.shadows.name(),
             ambient: (plan.mode == RenderMode::Hybrid).then(|| AmbientSummary {
-                ray_bands: plan.ray_bands(),
+                ray_bands: plan.ray_bands(settings.spp),
                 ambient_bands: plan.ambient_bands.name(),
                 occlusion_rays: plan.occlusion_rays,
             }),
@@ -329,21 +328,12 @@ fn check_settings(s: &RenderSettings) -> Result<()> {
 
 /// The hybrid ambient's overrides against their ranges.
 fn check_ambient(job: &RenderJob) -> Result<()> {
-    if let Some(AmbientBands::Fixed(b)) = job.ambient_bands
-        && !(1..=MAX_AMBIENT_BANDS).contains(&b)
-    {
-        return Err(PipelineError::parameter(format!(
-            "--ambient-bands {b} is not in 1..={MAX_AMBIENT_BANDS} (or auto)"
-        )));
-    }
-    if let Some(r) = job.occlusion_rays
-        && !(1..=MAX_AO_SAMPLES).contains(&r)
-    {
-        return Err(PipelineError::parameter(format!(
-            "--ao-rays {r} is not in 1..={MAX_AO_SAMPLES}"
-        )));
-    }
-    Ok(())
+    let bands = job.ambient_bands.map_or(Ok(()), AmbientBands::check);
+    let rays = job.occlusion_rays.map_or(Ok(()), check_occlusion_rays);
+    bands
+        .map_err(|e| format!("--ambient-bands {e}"))
+        .and_then(|()| rays.map_err(|e| format!("--ao-rays {e}")))
+        .map_err(PipelineError::parameter)
 }
 
 /// The composite, its PNG preview, and the layers: `OUT`, `OUT.png`, `OUT-with.EXT`, ...

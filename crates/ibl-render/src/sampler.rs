@@ -80,12 +80,7 @@ impl SobolStream {
     #[inline]
     pub fn next_2d(&mut self) -> [f32; 2] {
         let seed = self.next_seed();
-        let rev = shuffled_rev_index(self.index_rev, seed);
-        let base = seed.wrapping_mul(SEED_MULTIPLIER);
-        [
-            scrambled(self.tables.get(0, rev), base ^ DIMENSION_KEYS[0]),
-            scrambled(self.tables.get(1, rev), base ^ DIMENSION_KEYS[1]),
-        ]
+        self.tables.point(self.index_rev, seed)
     }
 
     /// Passes over the next pair without computing it: the pairs after it are those a
@@ -117,11 +112,8 @@ impl SobolStream {
     #[inline]
     pub fn next_1d(&mut self) -> f32 {
         let seed = self.next_seed();
-        let rev = shuffled_rev_index(self.index_rev, seed);
-        scrambled(
-            self.tables.get(0, rev),
-            seed.wrapping_mul(SEED_MULTIPLIER) ^ DIMENSION_KEYS[0],
-        )
+        // Inlined, the unused second coordinate is never computed.
+        self.tables.point(self.index_rev, seed)[0]
     }
 }
 
@@ -144,13 +136,9 @@ impl Iterator for JointPairs {
         if self.next >= self.end {
             return None;
         }
-        let rev = shuffled_rev_index(self.next.reverse_bits(), self.seed);
+        let point = self.tables.point(self.next.reverse_bits(), self.seed);
         self.next += 1;
-        let base = self.seed.wrapping_mul(SEED_MULTIPLIER);
-        Some([
-            scrambled(self.tables.get(0, rev), base ^ DIMENSION_KEYS[0]),
-            scrambled(self.tables.get(1, rev), base ^ DIMENSION_KEYS[1]),
-        ])
+        Some(point)
     }
 }
 
@@ -202,6 +190,19 @@ impl SobolTables {
     fn get(&self, dimension: usize, index_rev: u32) -> u32 {
         let t = &self.0[dimension];
         t[0][(index_rev >> 24) as usize] ^ t[1][((index_rev >> 16) & 0xff) as usize]
+    }
+
+    /// Point `index` (given with its bits reversed) of the (0,2)-sequence of dimensions 0 and 1
+    /// with its index shuffled and its digits Owen-scrambled by `seed`: bit for bit the first
+    /// two lanes of `sobol_burley::sample_4d(index, 0, seed)`.
+    #[inline]
+    fn point(&self, index_rev: u32, seed: u32) -> [f32; 2] {
+        let rev = shuffled_rev_index(index_rev, seed);
+        let base = seed.wrapping_mul(SEED_MULTIPLIER);
+        [
+            scrambled(self.get(0, rev), base ^ DIMENSION_KEYS[0]),
+            scrambled(self.get(1, rev), base ^ DIMENSION_KEYS[1]),
+        ]
     }
 }
 
@@ -296,12 +297,7 @@ mod tests {
                 .step_by(7)
                 .chain([SOBOL_MAX_SAMPLES - 1])
             {
-                let rev = shuffled_rev_index(index.reverse_bits(), seed);
-                let base = seed.wrapping_mul(SEED_MULTIPLIER);
-                let pair = [
-                    scrambled(TABLES.get(0, rev), base ^ DIMENSION_KEYS[0]),
-                    scrambled(TABLES.get(1, rev), base ^ DIMENSION_KEYS[1]),
-                ];
+                let pair = TABLES.point(index.reverse_bits(), seed);
                 let [a, b, _, _] = sobol_burley::sample_4d(index, 0, seed);
                 assert_eq!(pair, [a, b], "index {index}, seed {seed:#x}");
                 assert_eq!(pair[0], sobol_burley::sample(index, 0, seed));

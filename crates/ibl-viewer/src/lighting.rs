@@ -82,7 +82,7 @@ pub struct SceneLightingRequest {
 pub fn scene_lighting(request: &SceneLightingRequest) -> Result<SceneLighting, String> {
     let (lighting, set) = request
         .plan
-        .build(&request.scene)
+        .build(&request.scene, request.scene.lighting.spp)
         .map_err(|e| e.to_string())?;
     let set = set.ok_or_else(|| "the reference mode has no lights to draw".to_string())?;
     let (list, ambient) = match &lighting.illumination {

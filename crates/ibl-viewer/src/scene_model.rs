@@ -334,7 +334,6 @@ impl SceneModel {
             shadows: l.shadows,
             ambient_bands: l.ambient_bands,
             occlusion_rays: l.ao_samples,
-            samples_per_pixel: l.spp,
             seed: self.description.render.seed,
         }
     }

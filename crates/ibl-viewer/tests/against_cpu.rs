@@ -64,7 +64,9 @@ fn compare_model(name: &str, model: SceneModel) -> Option<(Image<Rgb>, Image<Rgb
 
     let scene = &model.scene;
     let plan = model.lighting_plan();
-    let (lighting, _) = plan.build(scene).expect("the same lights");
+    let (lighting, _) = plan
+        .build(scene, scene.lighting.spp)
+        .expect("the same lights");
     let settings = RenderSettings {
         composite: scene.render.composite,
         width: Some(WIDTH),

@@ -139,6 +139,17 @@ impl AmbientBands {
         }
     }
 
+    /// `Ok` for `auto` and a count in 1..=[`MAX_AMBIENT_BANDS`]; otherwise why not, for the
+    /// caller to prefix with the field or option that gave it.
+    pub fn check(self) -> Result<(), String> {
+        match self {
+            AmbientBands::Fixed(bands) if !(1..=MAX_AMBIENT_BANDS).contains(&bands) => Err(
+                format!("{bands} is not in 1..={MAX_AMBIENT_BANDS} (or \"auto\")"),
+            ),
+            _ => Ok(()),
+        }
+    }
+
     /// `auto` or the count, as files and the command line write it.
     pub fn name(self) -> String {
         match self {
@@ -157,11 +168,23 @@ impl std::str::FromStr for AmbientBands {
             return Ok(AmbientBands::Auto);
         }
         match s.trim().parse::<u32>() {
-            Ok(bands) if (1..=MAX_AMBIENT_BANDS).contains(&bands) => Ok(AmbientBands::Fixed(bands)),
+            Ok(bands) if AmbientBands::Fixed(bands).check().is_ok() => {
+                Ok(AmbientBands::Fixed(bands))
+            }
             _ => Err(format!(
                 "'{s}' is not \"auto\" or a band count in 1..={MAX_AMBIENT_BANDS}"
             )),
         }
+    }
+}
+
+/// `Ok` for a count of occlusion rays per sample in 1..=[`MAX_AO_SAMPLES`]; otherwise why not,
+/// for the caller to prefix with the field or option that gave it.
+pub fn check_occlusion_rays(rays: u32) -> Result<(), String> {
+    if (1..=MAX_AO_SAMPLES).contains(&rays) {
+        Ok(())
+    } else {
+        Err(format!("{rays} is not in 1..={MAX_AO_SAMPLES}"))
     }
 }
 
@@ -235,20 +258,10 @@ impl LightingDescription {
                 format!("{} is not in (0, 1]", self.adaptive_contrast),
             ));
         }
-        if let AmbientBands::Fixed(bands) = self.ambient_bands
-            && !(1..=MAX_AMBIENT_BANDS).contains(&bands)
-        {
-            return Err(invalid(
-                "lighting.ambient_bands",
-                format!("{bands} is not in 1..={MAX_AMBIENT_BANDS} (or \"auto\")"),
-            ));
-        }
-        if !(1..=MAX_AO_SAMPLES).contains(&self.ao_samples) {
-            return Err(invalid(
-                "lighting.ao_samples",
-                format!("{} is not in 1..={MAX_AO_SAMPLES}", self.ao_samples),
-            ));
-        }
+        self.ambient_bands
+            .check()
+            .map_err(|e| invalid("lighting.ambient_bands", e))?;
+        check_occlusion_rays(self.ao_samples).map_err(|e| invalid("lighting.ao_samples", e))?;
         Ok(())
     }
 }

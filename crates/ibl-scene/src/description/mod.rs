@@ -48,7 +48,7 @@ pub use geometry::{
 };
 pub use lighting::{
     AUTO_AMBIENT_BANDS, AmbientBands, LightingDescription, MAX_AMBIENT_BANDS, MAX_AO_SAMPLES,
-    ShadowKind,
+    ShadowKind, check_occlusion_rays,
 };
 pub use luminaire::{IntensityScale, LuminaireDescription, MAX_LUMINAIRES, validate_luminaires};
 pub use material::{
