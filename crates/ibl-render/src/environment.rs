@@ -19,19 +19,34 @@
 //! Texel coordinates of a sample are kept `1e-3` of a texel away from its edges so that the
 //! f32 direction maps back to the same texel: `pdf(sample.direction) == sample.pdf_sr`.
 //!
+//! **Half-sphere sampling.** A surface whose geometric normal is the probe's up (or down) axis,
+//! exactly (a floor or a ceiling under an upright probe), receives no light from the other half
+//! of the sphere, so drawing samples there wastes them: half of them under the apartment probe,
+//! whose floor is as bright as its walls. [`EnvironmentLight::region_for`] names the rows such a
+//! vertex can see ([`SampleRegion`]), and [`EnvironmentLight::sample_in`] draws only from them:
+//! the row from a marginal distribution over those rows alone, the column as before, so the
+//! density there is `p_ij / (P_region dOmega_j)` (`P_region` the region's share of the map's
+//! weight) and 0 elsewhere; [`EnvironmentLight::radiance_and_pdf_in`] gives the same density for
+//! multiple importance sampling. The upper half is rows `0..ceil(H / 2)`, the lower half rows
+//! `floor(H / 2)..H` (an odd height's middle row straddles the horizon and belongs to both), so
+//! every direction such a vertex can receive light from stays in the region and the estimate
+//! stays unbiased.
+//!
 //! Texel look-up uses `theta = atan2(sqrt(x^2 + z^2), y)`, well conditioned at the poles, and
-//! `phi = atan2(x, -z)` in f64. Cost: O(W H) to build (rows in parallel, sums in f64 per row),
-//! O(1) expected per sample (the guided inversion of [`Distribution1D`]), O(1) per radiance or
-//! density look-up.
+//! `phi = atan2(x, -z)` in f32 (within about `2.4e-7` rad: a thousandth of a texel up to 8192
+//! texels across, where the f64 functions cost a twentieth of a reference render). Each texel
+//! keeps its radiance and its density side by side (16 bytes), so a look-up reads one place.
+//! Cost: O(W H) to build (rows in parallel, sums in f64 per row), O(1) expected per sample (the
+//! guided inversion of [`Distribution1D`]), O(1) per radiance or density look-up.
 
-use std::f64::consts::{PI, TAU};
+use std::f64::consts::PI;
 
 use glam::{DVec3, Mat3, Vec3};
 use ibl_core::rgb::Rgb64;
 use ibl_core::{Image, LatLong, Rgb};
 use rayon::prelude::*;
 
-use crate::sampling::{Distribution1D, UniformCone};
+use crate::sampling::{Distribution1D, UniformCone, cos_sin_turn};
 
 /// How far (as a fraction of a texel) sampled texel coordinates stay from the texel's edges.
 const EDGE_MARGIN: f64 = 1e-3;
@@ -91,8 +106,9 @@ pub struct EnvSample {
 #[derive(Clone, Debug)]
 pub struct EnvironmentLight {
     latlong: LatLong,
-    /// Scaled radiance, row-major, row 0 at the top.
-    radiance: Vec<Rgb>,
+    /// Per texel, row-major, row 0 at the top: the scaled radiance and the density (1/sr) of
+    /// sampling a direction in it.
+    texels: Vec<Texel>,
     world_from_probe: Mat3,
     probe_from_world: Mat3,
     /// Exact solid angle (sr) of a texel in each row.
@@ -105,6 +121,38 @@ pub struct EnvironmentLight {
     conditionals: Vec<Distribution1D>,
     /// False when the map is black: sampling is then uniform over the sphere.
     importance: bool,
+    /// The upper and lower halves' own row distributions ([`SampleRegion`]).
+    halves: [HalfRows; 2],
+}
+
+/// The directions an environment sample is drawn from (module notes, "Half-sphere sampling").
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SampleRegion {
+    /// The whole sphere.
+    Sphere,
+    /// The probe's upper half, rows `0..ceil(H / 2)`: for a surface facing the probe's +Y.
+    Upper,
+    /// The probe's lower half, rows `floor(H / 2)..H`: for a surface facing the probe's -Y.
+    Lower,
+}
+
+/// The rows of one half of the map and their own distribution.
+#[derive(Clone, Debug)]
+struct HalfRows {
+    /// The half's first row.
+    first_row: usize,
+    /// Distribution over the half's rows (the same weights as the whole map's marginal).
+    marginal: Distribution1D,
+    /// `1 / P_half`: the whole map's weight over the half's (0 when the half is black).
+    density_scale: f32,
+}
+
+/// One texel's radiance and sampling density, read together.
+#[derive(Clone, Copy, Debug)]
+struct Texel {
+    radiance: Rgb,
+    /// Density (1/sr) of [`EnvironmentLight::sample`] within the texel.
+    pdf_sr: f32,
 }
 
 impl EnvironmentLight {
@@ -161,9 +209,48 @@ impl EnvironmentLight {
             .collect();
         let marginal = Distribution1D::new(conditionals.iter().map(Distribution1D::total));
         let importance = marginal.total() > 0.0;
+        let half = |first_row: usize, end_row: usize| {
+            let marginal = Distribution1D::new(
+                conditionals[first_row..end_row]
+                    .iter()
+                    .map(Distribution1D::total),
+            );
+            let density_scale = if marginal.total() > 0.0 {
+                (conditionals.iter().map(Distribution1D::total).sum::<f64>() / marginal.total())
+                    as f32
+            } else {
+                0.0
+            };
+            HalfRows {
+                first_row,
+                marginal,
+                density_scale,
+            }
+        };
+        let halves = [half(0, height.div_ceil(2)), half(height / 2, height)];
+        // `p_ij / dOmega_j` (module notes), or the uniform sphere's density for a black map.
+        let texels = radiance
+            .par_chunks_exact(width)
+            .zip(conditionals.par_iter())
+            .enumerate()
+            .flat_map_iter(|(j, (row, conditional))| {
+                let marginal = &marginal;
+                let row_solid_angle = row_solid_angle[j];
+                row.iter().enumerate().map(move |(i, &radiance)| {
+                    let pdf_sr = if importance {
+                        let p = f64::from(marginal.probability(j))
+                            * f64::from(conditional.probability(i));
+                        (p / row_solid_angle) as f32
+                    } else {
+                        UniformCone::SPHERE.pdf()
+                    };
+                    Texel { radiance, pdf_sr }
+                })
+            })
+            .collect();
         Ok(EnvironmentLight {
             latlong,
-            radiance,
+            texels,
             world_from_probe,
             probe_from_world: world_from_probe.transpose(),
             row_solid_angle,
@@ -171,6 +258,7 @@ impl EnvironmentLight {
             marginal,
             conditionals,
             importance,
+            halves,
         })
     }
 
@@ -186,25 +274,25 @@ impl EnvironmentLight {
 
     /// The texel `(column, row)` a world direction falls in (the direction need not be unit).
     pub fn texel_of(&self, dir_world: Vec3) -> (usize, usize) {
-        let d: DVec3 = (self.probe_from_world * dir_world).as_dvec3();
+        let d = self.probe_from_world * dir_world;
         // The squares of f32 values are exact in f64 and cannot overflow: no need for `hypot`.
-        let theta = (d.x * d.x + d.z * d.z).sqrt().atan2(d.y);
+        let (x, z) = (f64::from(d.x), f64::from(d.z));
+        let theta = ((x * x + z * z).sqrt() as f32).atan2(d.y);
         let phi = d.x.atan2(-d.z);
         let (w, h) = (self.latlong.width, self.latlong.height);
-        let mut u = phi / TAU + 0.5;
+        let mut u = phi * (0.5 * std::f32::consts::FRAC_1_PI) + 0.5;
         if u >= 1.0 {
             u -= 1.0;
         }
         // Float-to-int casts saturate (NaN gives 0), so any input maps to a valid texel.
-        let i = ((u * w as f64) as usize).min(w - 1);
-        let j = ((theta / PI * h as f64) as usize).min(h - 1);
+        let i = ((u * w as f32) as usize).min(w - 1);
+        let j = ((theta * std::f32::consts::FRAC_1_PI * h as f32) as usize).min(h - 1);
         (i, j)
     }
 
     /// Radiance arriving from the world direction `dir_world` (nearest texel, scaled).
     pub fn radiance(&self, dir_world: Vec3) -> Rgb {
-        let (i, j) = self.texel_of(dir_world);
-        self.radiance[j * self.latlong.width + i]
+        self.texel(dir_world).radiance
     }
 
     /// Density (1/sr) with which [`EnvironmentLight::sample`] draws `dir_world`.
@@ -215,27 +303,74 @@ impl EnvironmentLight {
     /// [`EnvironmentLight::radiance`] and [`EnvironmentLight::pdf`] of one direction, finding
     /// its texel once.
     pub fn radiance_and_pdf(&self, dir_world: Vec3) -> (Rgb, f32) {
-        let (i, j) = self.texel_of(dir_world);
-        let pdf = if self.importance {
-            self.texel_pdf(i, j)
-        } else {
-            UniformCone::SPHERE.pdf()
-        };
-        (self.radiance[j * self.latlong.width + i], pdf)
+        let texel = self.texel(dir_world);
+        (texel.radiance, texel.pdf_sr)
     }
 
-    fn texel_pdf(&self, i: usize, j: usize) -> f32 {
-        let p = f64::from(self.marginal.probability(j))
-            * f64::from(self.conditionals[j].probability(i));
-        (p / self.row_solid_angle[j]) as f32
+    /// [`EnvironmentLight::radiance_and_pdf`] with the density of
+    /// [`EnvironmentLight::sample_in`] of `region`: 0 outside its rows.
+    pub fn radiance_and_pdf_in(&self, region: SampleRegion, dir_world: Vec3) -> (Rgb, f32) {
+        let (i, j) = self.texel_of(dir_world);
+        let texel = self.texels[j * self.latlong.width + i];
+        (texel.radiance, texel.pdf_sr * self.region_scale(region, j))
+    }
+
+    /// The region a surface with the world geometric normal `normal` can receive light from:
+    /// a half when the normal is exactly the probe's up or down axis (its other two
+    /// components exactly 0), the whole sphere otherwise and for a black map.
+    pub fn region_for(&self, normal: Vec3) -> SampleRegion {
+        let n = self.probe_from_world * normal;
+        match (self.importance && n.x == 0.0 && n.z == 0.0, n.y) {
+            (true, y) if y > 0.0 => SampleRegion::Upper,
+            (true, y) if y < 0.0 => SampleRegion::Lower,
+            _ => SampleRegion::Sphere,
+        }
+    }
+
+    /// The factor from the whole sphere's density to `region`'s in row `j`.
+    #[inline]
+    fn region_scale(&self, region: SampleRegion, j: usize) -> f32 {
+        let half = match region {
+            // A black map is sampled uniformly over the sphere in every region.
+            _ if !self.importance => return 1.0,
+            SampleRegion::Sphere => return 1.0,
+            SampleRegion::Upper => &self.halves[0],
+            SampleRegion::Lower => &self.halves[1],
+        };
+        let rows = half.first_row..half.first_row + half.marginal.len();
+        if rows.contains(&j) {
+            half.density_scale
+        } else {
+            0.0
+        }
+    }
+
+    /// The texel a world direction falls in.
+    #[inline]
+    fn texel(&self, dir_world: Vec3) -> Texel {
+        let (i, j) = self.texel_of(dir_world);
+        self.texels[j * self.latlong.width + i]
     }
 
     /// A direction drawn with density proportional to luminance (uniform within a texel) from
     /// `u1, u2` in `[0, 1)`: `u1` picks the row, `u2` the column. O(1) expected, O(log W +
     /// log H) at worst.
     pub fn sample(&self, u1: f32, u2: f32) -> EnvSample {
+        self.sample_in(SampleRegion::Sphere, u1, u2)
+    }
+
+    /// [`EnvironmentLight::sample`] within `region` (module notes, "Half-sphere sampling"):
+    /// `u1` picks the row among the region's, `u2` the column. A black half gives density 0
+    /// (no light can come from it).
+    pub fn sample_in(&self, region: SampleRegion, u1: f32, u2: f32) -> EnvSample {
+        let (marginal, first_row) = match region {
+            SampleRegion::Sphere => (&self.marginal, 0),
+            SampleRegion::Upper => (&self.halves[0].marginal, self.halves[0].first_row),
+            SampleRegion::Lower => (&self.halves[1].marginal, self.halves[1].first_row),
+        };
         let chosen = if self.importance {
-            self.marginal.sample(u1).and_then(|row| {
+            marginal.sample(u1).and_then(|mut row| {
+                row.index += first_row;
                 self.conditionals[row.index]
                     .sample(u2)
                     .map(|column| (row, column))
@@ -255,29 +390,33 @@ impl EnvironmentLight {
         let i = column.index;
         let inset = |f: f32| EDGE_MARGIN + (1.0 - 2.0 * EDGE_MARGIN) * f64::from(f);
         let w = self.latlong.width;
-        let phi = TAU * ((i as f64 + inset(column.remapped)) / w as f64 - 0.5);
+        // `phi = 2 pi (t - 1/2)`, so `(cos phi, sin phi) = -(cos 2 pi t, sin 2 pi t)`, each
+        // within 2e-7 ([`cos_sin_turn`]).
+        let t = (i as f64 + inset(column.remapped)) / w as f64;
+        let (cos_turn, sin_turn) = cos_sin_turn(t as f32);
         let (c0, c1) = (self.row_edge_cos[j], self.row_edge_cos[j + 1]);
         let cos_theta = c0 + inset(row.remapped) * (c1 - c0);
         let sin_theta = ((1.0 - cos_theta) * (1.0 + cos_theta)).max(0.0).sqrt();
-        let (sp, cp) = phi.sin_cos();
+        let (sp, cp) = (-f64::from(sin_turn), -f64::from(cos_turn));
         let probe_dir = DVec3::new(sin_theta * sp, cos_theta, -sin_theta * cp).as_vec3();
+        let texel = self.texels[j * w + i];
         EnvSample {
             direction: (self.world_from_probe * probe_dir).normalize_or(Vec3::Y),
-            radiance: self.radiance[j * w + i],
-            pdf_sr: self.texel_pdf(i, j),
+            radiance: texel.radiance,
+            pdf_sr: texel.pdf_sr * self.region_scale(region, j),
         }
     }
 
     /// Power per channel, `sum_p L_p dOmega_p` (scaled radiance x sr), accumulated in f64 per row
     /// and then over rows in order (CONVENTIONS section 4).
     pub fn total_power(&self) -> Rgb64 {
-        self.radiance
+        self.texels
             .chunks_exact(self.latlong.width)
             .zip(&self.row_solid_angle)
             .fold(Rgb64::ZERO, |total, (row, &d_omega)| {
                 let mut row_sum = Rgb64::ZERO;
-                for &l in row {
-                    row_sum.add_weighted(l, d_omega);
+                for texel in row {
+                    row_sum.add_weighted(texel.radiance, d_omega);
                 }
                 total + row_sum
             })

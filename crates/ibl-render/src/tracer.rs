@@ -2,7 +2,9 @@
 //! the three lighting modes, through the scene with or without its virtual objects.
 //!
 //! - **reference**: a unidirectional path tracer (Kajiya 1986) with next-event estimation. At each
-//!   diffuse or glossy vertex one environment sample (importance-sampled by texel power) and the
+//!   diffuse or glossy vertex one environment sample (importance-sampled by texel power, from the
+//!   probe's upper or lower half alone where the surface faces one of its poles exactly, a floor
+//!   or a ceiling: [`crate::environment::EnvironmentLight::region_for`]) and the
 //!   BSDF sample that continues the path are combined by the power heuristic (Veach 1997, multiple
 //!   importance sampling); an escaping BSDF sample adds the probe's radiance with the
 //!   complementary weight. Mirrors are delta: escaping mirror rays add the probe unweighted. Paths
@@ -56,6 +58,7 @@ use ibl_scene::bvh::OccluderHint;
 use ibl_scene::{Hit, Ray, Scene, ShadowKind, SurfacePoint};
 use rayon::prelude::*;
 
+use crate::environment::SampleRegion;
 use crate::lighting::{Ambient, Illumination, LightList, Lighting, RayRole};
 use crate::material::Bsdf;
 use crate::sampler::SampleStream;
@@ -409,8 +412,10 @@ impl<'a> Tracer<'a> {
         let mut throughput = Rgb::ONE;
         let mut ray = ray;
         let mut primary = PrimaryHit::Background;
-        // Density of the BSDF sample that made `ray` (None: camera ray or mirror).
-        let mut bsdf_pdf: Option<f32> = None;
+        // Density of the BSDF sample that made `ray` (None: camera ray or mirror), and the
+        // region its vertex's environment sample was drawn from (its MIS partner).
+        let mut bsdf_pdf: Option<(f32, SampleRegion)> = None;
+        let mut region = SampleRegion::Sphere;
         let mut vertex = 0u32;
         let mut without_objects = None;
         let mut new_light = Rgb::ZERO;
@@ -446,11 +451,15 @@ impl<'a> Tracer<'a> {
                 match &self.lighting.illumination {
                     Illumination::Environment => {
                         let vertex = Vertex::new(&surface, &bsdf, wo);
+                        region = self
+                            .lighting
+                            .environment
+                            .region_for(surface.geometric_normal);
                         let none = LayeredLight::none(&state);
                         let luminaires = self.luminaires(&vertex, &mut state, none);
                         new_light += throughput * luminaires.with;
                         radiance += throughput
-                            * (self.environment_sample(&vertex, stream, &mut state)
+                            * (self.environment_sample(&vertex, region, stream, &mut state)
                                 + luminaires.with);
                     }
                     Illumination::Lights(list) => {
@@ -489,7 +498,7 @@ impl<'a> Tracer<'a> {
                 break;
             };
             throughput = throughput * sample.weight;
-            bsdf_pdf = (!sample.is_delta).then_some(sample.pdf_sr);
+            bsdf_pdf = (!sample.is_delta).then_some((sample.pdf_sr, region));
             if vertex >= ROULETTE_FROM {
                 let survive = throughput.max_channel().min(0.95);
                 if survive <= 0.0 || stream.next_1d() >= survive {
@@ -515,14 +524,15 @@ impl<'a> Tracer<'a> {
     }
 
     /// Radiance added by a ray that left the scene; `bsdf_pdf` is the density of the BSDF sample
-    /// that made it (`None` for the camera ray or a mirror bounce).
-    fn escaped(&self, direction: Vec3, bsdf_pdf: Option<f32>) -> Rgb {
+    /// that made it and the region of its vertex's environment sample (`None` for the camera
+    /// ray or a mirror bounce).
+    fn escaped(&self, direction: Vec3, bsdf_pdf: Option<(f32, SampleRegion)>) -> Rgb {
         let env = &self.lighting.environment;
         match (&self.lighting.illumination, bsdf_pdf) {
             // The camera, or a mirror: the probe itself in every mode.
             (_, None) => env.radiance(direction),
-            (Illumination::Environment, Some(pdf)) => {
-                let (radiance, env_pdf) = env.radiance_and_pdf(direction);
+            (Illumination::Environment, Some((pdf, region))) => {
+                let (radiance, env_pdf) = env.radiance_and_pdf_in(region, direction);
                 radiance * power_heuristic(pdf, env_pdf)
             }
             // The lights (and the ambient) stand for the probe; their paths end at the first
@@ -531,16 +541,19 @@ impl<'a> Tracer<'a> {
         }
     }
 
-    /// One environment sample, MIS-weighted against BSDF sampling.
+    /// One environment sample from `region` (the half a floor or ceiling can see, else the
+    /// sphere: [`crate::environment::EnvironmentLight::region_for`]), MIS-weighted against
+    /// BSDF sampling.
     fn environment_sample(
         &self,
         vertex: &Vertex,
+        region: SampleRegion,
         stream: &mut SampleStream,
         state: &mut PathState,
     ) -> Rgb {
         let env = &self.lighting.environment;
         let [u1, u2] = stream.next_2d();
-        let sample = env.sample(u1, u2);
+        let sample = env.sample_in(region, u1, u2);
         let wi = sample.direction;
         if sample.pdf_sr <= 0.0 {
             return Rgb::ZERO;

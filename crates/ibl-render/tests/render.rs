@@ -397,6 +397,62 @@ vertical_fov_deg = 50.0
 image_size_px = [64, 48]
 "#;
 
+#[test]
+fn a_floor_reflects_its_exact_irradiance_from_the_upper_half() {
+    // Closed form: a flat diffuse floor, alone under a probe, sees the probe's upper half and
+    // nothing else, so it reflects `albedo E / pi` everywhere, `E` the sum over the upper rows'
+    // texels of `L dphi (sin^2 theta_1 - sin^2 theta_0) / 2` (a texel's cosine-weighted solid
+    // angle). Its environment samples come from the upper half alone
+    // (`EnvironmentLight::region_for`); a wrong density there (the half's weight, or its
+    // multiple-importance weight against the BSDF's) would move every pixel by the same factor.
+    // The pixels' estimates are independent, so their mean has standard error sd / sqrt(n):
+    // |z| < 4, as in the furnace test.
+    let probe = sky_probe();
+    let toml = format!(
+        "version = 1\n[probe]\nfile = \"sky.exr\"\n\
+         [camera]\nposition = [0.0, 0.0, 0.0]\nlook_at = [0.0, -1.0, -0.3]\n\
+         vertical_fov_deg = 40.0\nimage_size_px = [48, 36]\n{GROUND}"
+    );
+    let scene = scene(&toml, probe.clone());
+    let lighting = Lighting::reference(&scene).unwrap();
+    let out = run(
+        &scene,
+        &lighting,
+        &settings(8, 2, 3, CompositeRule::Difference),
+    );
+    let dphi = 2.0 * PI / PROBE_W as f64;
+    let mut irradiance = [0.0_f64; 3];
+    for y in 0..PROBE_H / 2 {
+        let (t0, t1) = (
+            PI * y as f64 / PROBE_H as f64,
+            PI * (y + 1) as f64 / PROBE_H as f64,
+        );
+        let weight = dphi * (t1.sin().powi(2) - t0.sin().powi(2)) / 2.0;
+        for x in 0..PROBE_W {
+            let l = probe.get(x, y);
+            for (e, c) in irradiance.iter_mut().zip([l.r, l.g, l.b]) {
+                *e += f64::from(c) * weight;
+            }
+        }
+    }
+    let albedo = [0.6, 0.55, 0.5];
+    for k in 0..3 {
+        let values: Vec<f64> = out
+            .with_objects
+            .pixels()
+            .iter()
+            .map(|p| f64::from(p[k]))
+            .collect();
+        let (mean, sd) = mean_and_sd(&values);
+        let expected = albedo[k] * irradiance[k] / PI;
+        let z = (mean - expected) / (sd / (values.len() as f64).sqrt());
+        assert!(
+            z.abs() < 4.0,
+            "channel {k}: mean {mean} expected {expected} (z = {z})"
+        );
+    }
+}
+
 /// The three modes' lighting of `scene` (lights and hybrid from 4 median-cut lights).
 fn every_mode(scene: &Scene) -> Vec<(&'static str, Lighting)> {
     let lights = plan(RenderMode::Lights, 4, ShadowKind::Hard)

@@ -9,7 +9,7 @@ use std::f64::consts::PI;
 
 use glam::{Mat3, Vec3};
 use ibl_core::{Image, LatLong, Rgb};
-use ibl_render::environment::EnvironmentLight;
+use ibl_render::environment::{EnvironmentLight, SampleRegion};
 use ibl_render::material::Bsdf;
 use ibl_render::sampling::{
     OrthonormalBasis, PixelRng, UniformCone, cosine_hemisphere_pdf, power_heuristic,
@@ -253,19 +253,34 @@ fn environment_pdf_integrates_to_one_over_the_sphere() {
     ] {
         let env = EnvironmentLight::new(map, rotation, 1.0).unwrap();
         let cell = 4.0 * PI / (NZ * NPHI) as f64;
-        let mut total = 0.0_f64;
+        // The sphere's density and each half's (module notes of `environment`).
+        let regions = [
+            SampleRegion::Sphere,
+            SampleRegion::Upper,
+            SampleRegion::Lower,
+        ];
+        let mut totals = [0.0_f64; 3];
         for iz in 0..NZ {
-            let mut row = 0.0_f64;
+            let mut rows = [0.0_f64; 3];
             for ip in 0..NPHI {
                 let z = 1.0 - 2.0 * (iz as f64 + f64::from(rng.next_f32())) / NZ as f64;
                 let r = (1.0 - z * z).max(0.0).sqrt();
                 let phi = 2.0 * PI * (ip as f64 + f64::from(rng.next_f32())) / NPHI as f64;
                 let d = Vec3::new((r * phi.cos()) as f32, z as f32, (r * phi.sin()) as f32);
-                row += f64::from(env.pdf(d));
+                for (row, region) in rows.iter_mut().zip(regions) {
+                    *row += f64::from(env.radiance_and_pdf_in(region, d).1);
+                }
             }
-            total += row * cell;
+            for (total, row) in totals.iter_mut().zip(rows) {
+                *total += row * cell;
+            }
         }
-        assert!((total - 1.0).abs() < 1e-3, "integral of the pdf {total}");
+        for (total, region) in totals.iter().zip(regions) {
+            assert!(
+                (total - 1.0).abs() < 1e-3,
+                "integral of the {region:?} pdf {total}"
+            );
+        }
     }
 }
 
@@ -286,6 +301,80 @@ fn environment_samples_agree_with_pdf_and_radiance() {
         assert_eq!(env.radiance(s.direction), s.radiance);
         assert!(s.radiance.max_channel() > 0.0, "a black texel was sampled");
     }
+}
+
+#[test]
+fn half_sphere_regions_sample_their_half_with_their_density() {
+    // A floor (+Y) and a ceiling (-Y) under a probe turned about its up axis, on an even and an
+    // odd height: the odd one's middle row straddles the horizon and belongs to both halves, so
+    // its samples may lie up to that row's height (pi / 31 rad) past the horizon.
+    let yaw = Mat3::from_rotation_y(0.7);
+    for height in [32, 31] {
+        let env = EnvironmentLight::new(random_map(64, height), yaw, 2.0).unwrap();
+        let past_horizon = if height % 2 == 1 {
+            (PI / height as f64).sin() as f32
+        } else {
+            1e-6
+        };
+        for (normal, region) in [
+            (Vec3::Y, SampleRegion::Upper),
+            (Vec3::NEG_Y, SampleRegion::Lower),
+        ] {
+            assert_eq!(env.region_for(normal), region);
+            let mut rng = PixelRng::new(15, 0, 0);
+            for _ in 0..100_000 {
+                let s = env.sample_in(region, rng.next_f32(), rng.next_f32());
+                assert!(
+                    s.direction.dot(normal) > -past_horizon,
+                    "{region:?}: {} outside the half",
+                    s.direction
+                );
+                assert!(s.pdf_sr > 0.0);
+                let (radiance, pdf) = env.radiance_and_pdf_in(region, s.direction);
+                assert_eq!(radiance, s.radiance);
+                assert!(
+                    (pdf - s.pdf_sr).abs() <= 1e-6 * s.pdf_sr,
+                    "pdf {pdf} vs sampled {}",
+                    s.pdf_sr
+                );
+                // The half holds at most the whole map's weight: its density is at least the
+                // sphere's.
+                assert!(s.pdf_sr >= env.pdf(s.direction) * (1.0 - 1e-6));
+            }
+            // The other pole lies outside the half: density 0 there.
+            assert_eq!(env.radiance_and_pdf_in(region, -normal).1, 0.0);
+        }
+    }
+}
+
+#[test]
+fn only_a_surface_facing_the_probes_poles_exactly_samples_a_half() {
+    let env = EnvironmentLight::new(random_map(64, 32), Mat3::from_rotation_y(2.0), 1.0).unwrap();
+    assert_eq!(env.region_for(Vec3::Y), SampleRegion::Upper);
+    assert_eq!(
+        env.region_for(Vec3::new(0.0, 3.0, 0.0)),
+        SampleRegion::Upper
+    );
+    assert_eq!(env.region_for(Vec3::NEG_Y), SampleRegion::Lower);
+    // A tilted surface, or a tilted probe: the sphere.
+    let tilted = Vec3::new(1e-3, 1.0, 0.0).normalize();
+    assert_eq!(env.region_for(tilted), SampleRegion::Sphere);
+    assert_eq!(env.region_for(Vec3::X), SampleRegion::Sphere);
+    assert_eq!(env.region_for(Vec3::ZERO), SampleRegion::Sphere);
+    assert_eq!(env.region_for(Vec3::splat(f32::NAN)), SampleRegion::Sphere);
+    let tilted_probe = EnvironmentLight::new(random_map(64, 32), rotation(), 1.0).unwrap();
+    assert_eq!(tilted_probe.region_for(Vec3::Y), SampleRegion::Sphere);
+    // A black map is sampled uniformly over the sphere in every region.
+    let black =
+        EnvironmentLight::new(Image::filled(16, 8, Rgb::ZERO), Mat3::IDENTITY, 1.0).unwrap();
+    assert_eq!(black.region_for(Vec3::Y), SampleRegion::Sphere);
+    let s = black.sample_in(SampleRegion::Upper, 0.3, 0.7);
+    assert_eq!(
+        black
+            .radiance_and_pdf_in(SampleRegion::Upper, s.direction)
+            .1,
+        s.pdf_sr
+    );
 }
 
 #[test]
