@@ -326,8 +326,8 @@ mod tests {
         let img = probe(200, 100, |_, _| 1.0);
         let dirs = ibl_core::fibonacci_normals(300);
         let mut lights: Vec<Light> = dirs.iter().map(|d| light(*d)).collect();
-        size_by_cells(&img, &Grid::new(&img).unwrap(), &mut lights);
         let grid = Grid::new(&img).unwrap();
+        size_by_cells(&img, &grid, &mut lights);
         let expected = brute_force(&grid, &dirs);
         let mut total = 0.0;
         for (l, e) in lights.iter().zip(&expected) {
@@ -373,7 +373,7 @@ mod tests {
         });
         let grid = Grid::new(&img).unwrap();
         let mut lights = vec![light(grid.dir(64, 21))];
-        size_by_cells(&img, &Grid::new(&img).unwrap(), &mut lights);
+        size_by_cells(&img, &grid, &mut lights);
         let l = &lights[0];
         assert!((l.solid_angle_sr - 4.0 * std::f64::consts::PI).abs() < 1e-9);
         let patch = 9.0 * grid.row_sr[21];

@@ -210,20 +210,19 @@ impl EnvironmentLight {
         let marginal = Distribution1D::new(conditionals.iter().map(Distribution1D::total));
         let importance = marginal.total() > 0.0;
         let half = |first_row: usize, end_row: usize| {
-            let marginal = Distribution1D::new(
+            let half_marginal = Distribution1D::new(
                 conditionals[first_row..end_row]
                     .iter()
                     .map(Distribution1D::total),
             );
-            let density_scale = if marginal.total() > 0.0 {
-                (conditionals.iter().map(Distribution1D::total).sum::<f64>() / marginal.total())
-                    as f32
+            let density_scale = if half_marginal.total() > 0.0 {
+                (marginal.total() / half_marginal.total()) as f32
             } else {
                 0.0
             };
             HalfRows {
                 first_row,
-                marginal,
+                marginal: half_marginal,
                 density_scale,
             }
         };
@@ -292,7 +291,8 @@ impl EnvironmentLight {
 
     /// Radiance arriving from the world direction `dir_world` (nearest texel, scaled).
     pub fn radiance(&self, dir_world: Vec3) -> Rgb {
-        self.texel(dir_world).radiance
+        let (i, j) = self.texel_of(dir_world);
+        self.texels[j * self.latlong.width + i].radiance
     }
 
     /// Density (1/sr) with which [`EnvironmentLight::sample`] draws `dir_world`.
@@ -303,8 +303,7 @@ impl EnvironmentLight {
     /// [`EnvironmentLight::radiance`] and [`EnvironmentLight::pdf`] of one direction, finding
     /// its texel once.
     pub fn radiance_and_pdf(&self, dir_world: Vec3) -> (Rgb, f32) {
-        let texel = self.texel(dir_world);
-        (texel.radiance, texel.pdf_sr)
+        self.radiance_and_pdf_in(SampleRegion::Sphere, dir_world)
     }
 
     /// [`EnvironmentLight::radiance_and_pdf`] with the density of
@@ -343,13 +342,6 @@ impl EnvironmentLight {
         } else {
             0.0
         }
-    }
-
-    /// The texel a world direction falls in.
-    #[inline]
-    fn texel(&self, dir_world: Vec3) -> Texel {
-        let (i, j) = self.texel_of(dir_world);
-        self.texels[j * self.latlong.width + i]
     }
 
     /// A direction drawn with density proportional to luminance (uniform within a texel) from
