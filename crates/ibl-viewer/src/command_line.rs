@@ -149,7 +149,9 @@ pub struct ViewArgs {
     /// Glossy reflections.
     #[arg(long, value_enum, default_value = "lights")]
     pub glossy: GlossyArg,
-    /// Background rays per pixel axis (4, as `ibl render`, antialiases the magnified probe).
+    /// The background's antialiasing: where the probe is magnified each pixel takes its area's
+    /// share of the 2 x 2 texels under it (as `ibl render`); elsewhere (a pole, a minified probe)
+    /// N x N rays per pixel. 1: the texel at the pixel's centre only.
     #[arg(long, value_name = "N", default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=8))]
     pub background_rays: u32,
     /// Marks file (`iblkit.marks/1`, docs/ROOMS.md) whose lines are drawn over a probe; the

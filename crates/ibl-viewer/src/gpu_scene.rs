@@ -161,13 +161,33 @@ pub fn vec4(v: glam::Vec3, w: f32) -> [f32; 4] {
     Vec4::new(v.x, v.y, v.z, w).to_array()
 }
 
-/// One vertex buffer.
+/// One mesh's vertex and index buffers ([`crate::scene_geometry::shared_vertices`]).
 #[derive(Debug)]
 pub struct MeshBuffer {
-    /// The vertices (three per triangle).
+    /// The distinct vertices.
     pub buffer: wgpu::Buffer,
-    /// How many vertices.
-    pub vertices: u32,
+    /// Three indices per triangle (u32).
+    pub index_buffer: wgpu::Buffer,
+    /// How many indices.
+    pub indices: u32,
+}
+
+impl MeshBuffer {
+    /// Whether the mesh has no triangles (its buffers then hold a stand-in, never drawn).
+    pub fn is_empty(&self) -> bool {
+        self.indices == 0
+    }
+
+    /// Binds the vertex buffer (slot 0) and the index buffer.
+    pub fn bind(&self, pass: &mut wgpu::RenderPass<'_>) {
+        pass.set_vertex_buffer(0, self.buffer.slice(..));
+        pass.set_index_buffer(self.index_buffer.slice(..), wgpu::IndexFormat::Uint32);
+    }
+
+    /// Draws every triangle as `instances` (after [`MeshBuffer::bind`]).
+    pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>, instances: std::ops::Range<u32>) {
+        pass.draw_indexed(0..self.indices, 0, instances);
+    }
 }
 
 /// Buffers of a scene.
@@ -191,22 +211,37 @@ pub struct GpuScene {
 }
 
 fn mesh(gpu: &GpuContext, label: &str, vertices: &[crate::scene_geometry::Vertex]) -> MeshBuffer {
-    // wgpu refuses empty buffers: one degenerate vertex stands in (never drawn).
-    let dummy = [crate::scene_geometry::Vertex::zeroed()];
-    let data: &[crate::scene_geometry::Vertex] = if vertices.is_empty() {
-        &dummy
+    let (kept, indices) = crate::scene_geometry::shared_vertices(vertices);
+    // wgpu refuses empty buffers: one degenerate vertex and triangle stand in (never drawn).
+    let (kept, stand_in) = if kept.is_empty() {
+        (vec![crate::scene_geometry::Vertex::zeroed()], vec![0; 3])
     } else {
-        vertices
+        (kept, Vec::new())
+    };
+    let init = |contents: &[u8], usage, suffix: &str| {
+        gpu.device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(&format!("{label} {suffix}")),
+                contents,
+                usage,
+            })
     };
     MeshBuffer {
-        buffer: gpu
-            .device
-            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents: bytemuck::cast_slice(data),
-                usage: wgpu::BufferUsages::VERTEX,
+        buffer: init(
+            bytemuck::cast_slice(&kept),
+            wgpu::BufferUsages::VERTEX,
+            "vertices",
+        ),
+        index_buffer: init(
+            bytemuck::cast_slice(if indices.is_empty() {
+                &stand_in
+            } else {
+                &indices
             }),
-        vertices: vertices.len() as u32,
+            wgpu::BufferUsages::INDEX,
+            "indices",
+        ),
+        indices: indices.len() as u32,
     }
 }
 

@@ -7,6 +7,7 @@
 //!
 //! Each object keeps a BVH of its triangles (in the load frame) for picking with the mouse.
 
+use std::collections::HashMap;
 use std::ops::Range;
 
 use bytemuck::{Pod, Zeroable};
@@ -109,6 +110,26 @@ fn object(name: String, vertices: Vec<Vertex>) -> ObjectGeometry {
     }
 }
 
+/// The triangles of `vertices` (three per triangle) as shared vertices and indices into them:
+/// equal vertices (bit for bit: position, normal and material) kept once, in order of first use.
+/// A rasteriser transforms a kept vertex once per draw where it can reuse it (lavapipe's vertex
+/// cache): a list of three vertices per triangle transforms every corner, about six per vertex
+/// of a smooth mesh, in every shadow-map tile it is drawn into. O(n) expected.
+pub fn shared_vertices(vertices: &[Vertex]) -> (Vec<Vertex>, Vec<u32>) {
+    let mut index_of: HashMap<[u32; 7], u32> = HashMap::with_capacity(vertices.len() / 4);
+    let mut kept = Vec::new();
+    let indices = vertices
+        .iter()
+        .map(|v| {
+            *index_of.entry(bytemuck::cast(*v)).or_insert_with(|| {
+                kept.push(*v);
+                kept.len() as u32 - 1
+            })
+        })
+        .collect();
+    (kept, indices)
+}
+
 impl SceneGeometry {
     /// The geometry of a loaded scene. O(T log T) for T triangles (the picking BVHs).
     pub fn from_scene(scene: &Scene) -> SceneGeometry {
@@ -173,6 +194,39 @@ mod tests {
             objects: Vec::new(),
             materials: Vec::new(),
         }
+    }
+
+    #[test]
+    fn shared_vertices_give_back_every_triangle() {
+        // Two triangles sharing an edge, a third with the same corners but another normal, and
+        // one whose corner differs only in its material: 12 corners, 7 distinct vertices.
+        let v = |position: [f32; 3], normal: [f32; 3], material: u32| Vertex {
+            position,
+            normal,
+            material,
+        };
+        let (a, b, c, d) = ([0.0; 3], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 1.0]);
+        let (up, tilted) = ([0.0, 1.0, 0.0], [0.0, 0.6, 0.8]);
+        let corners = [
+            v(a, up, 0),
+            v(b, up, 0),
+            v(c, up, 0),
+            v(b, up, 0),
+            v(d, up, 0),
+            v(c, up, 0),
+            v(a, tilted, 0),
+            v(b, tilted, 0),
+            v(c, tilted, 0),
+            v(a, up, 1),
+            v(b, up, 0),
+            v(c, up, 0),
+        ];
+        let (kept, indices) = shared_vertices(&corners);
+        assert_eq!(kept.len(), 8);
+        assert_eq!(indices.len(), corners.len());
+        let rebuilt: Vec<Vertex> = indices.iter().map(|&i| kept[i as usize]).collect();
+        assert_eq!(rebuilt, corners);
+        assert_eq!(shared_vertices(&[]), (Vec::new(), Vec::new()));
     }
 
     #[test]

@@ -531,16 +531,16 @@ fn geometry_pipeline(
 
 /// Draws the real geometry (instance 0) and each virtual object (instance k + 1).
 fn draw_geometry(pass: &mut wgpu::RenderPass<'_>, scene: &GpuScene) {
-    if scene.real.vertices > 0 {
-        pass.set_vertex_buffer(0, scene.real.buffer.slice(..));
-        pass.draw(0..scene.real.vertices, 0..1);
+    if !scene.real.is_empty() {
+        scene.real.bind(pass);
+        scene.real.draw(pass, 0..1);
     }
     for (k, mesh) in scene.objects.iter().enumerate() {
-        if mesh.vertices == 0 {
+        if mesh.is_empty() {
             continue;
         }
         let object = k as u32 + 1;
-        pass.set_vertex_buffer(0, mesh.buffer.slice(..));
-        pass.draw(0..mesh.vertices, object..object + 1);
+        mesh.bind(pass);
+        mesh.draw(pass, object..object + 1);
     }
 }

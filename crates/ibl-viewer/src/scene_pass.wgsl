@@ -74,7 +74,7 @@ override PHOTO_BACKGROUND: bool = false;
 override GLOSSY_FROM_PROBE: bool = false;
 // The hybrid ambient's irradiance map is bound.
 override HAS_AMBIENT: bool = false;
-// Background rays per pixel axis (1 to 8).
+// Background rays per pixel axis (1 to 8) where the probe is minified or at a pole (`background`).
 override BACKGROUND_RAYS: u32 = 4u;
 // Real surfaces take only their screen tile's lights (light_tiles.wgsl; else every light).
 override TILED_LIGHTS: bool = false;
@@ -150,49 +150,107 @@ fn photo_pixel(pixel: vec2<f32>) -> vec3<f32> {
     return textureLoad(photo, vec2<i32>(pixel), 0).rgb * frame.environment.z;
 }
 
-// B seen through the pixel at `pixel` (its top-left corner is floor(pixel)) along camera rays.
-fn background_sky(pixel: vec2<f32>) -> vec3<f32> {
-    if PHOTO_BACKGROUND {
-        return photo_pixel(pixel);
-    }
-    let n = BACKGROUND_RAYS;
-    let corner = floor(pixel);
-    var sum = vec3<f32>(0.0);
-    for (var sy = 0u; sy < n; sy = sy + 1u) {
-        for (var sx = 0u; sx < n; sx = sx + 1u) {
-            let at = corner + (vec2<f32>(f32(sx), f32(sy)) + 0.5) / f32(n);
-            sum = sum + probe_nearest(camera_ray(at));
-        }
-    }
-    return sum / f32(n * n);
+// Continuous texel coordinates (column, row; texel (i, j) spans [i, i + 1) x [j, j + 1)) of world
+// direction d in the probe, as probe_texel before its rounding.
+fn probe_coords(d: vec3<f32>, size: vec2<f32>) -> vec2<f32> {
+    let local = (frame.probe_from_world * vec4<f32>(d, 0.0)).xyz;
+    let uv = dir_to_uv(local);
+    return vec2<f32>((uv.x - floor(uv.x)) * size.x, uv.y * size.y);
 }
 
-// B on a real surface point p with camera-facing geometric normal ng, seen from the probe's
-// centre: each sub-pixel camera ray meets the surface's plane, and the probe is read along the
-// direction from its centre to there.
-fn background_surface(pixel: vec2<f32>, p: vec3<f32>, ng: vec3<f32>) -> vec3<f32> {
+// The direction the background is read along for the camera ray through image point `at`: the
+// ray itself on the sky; on a real surface (`on_plane`), from the probe's centre to where the
+// ray meets the surface's plane (through p, camera-facing normal ng, `height` = (p - eye) . ng).
+fn background_direction(at: vec2<f32>, on_plane: bool, p: vec3<f32>, ng: vec3<f32>, height: f32) -> vec3<f32> {
+    let d = camera_ray(at);
+    if !on_plane {
+        return d;
+    }
+    let cos_d = dot(d, ng);
+    // A ray (nearly) parallel to the plane keeps the pixel centre's point.
+    var q = p;
+    if cos_d < -1e-4 {
+        q = frame.camera_position.xyz + d * (height / cos_d);
+    }
+    return normalize(q - frame.probe_position.xyz);
+}
+
+// The share of a pixel's footprint lying past a line `x` texels from its centre, along one texel
+// axis. The footprint (linearised) is the parallelogram `centre + s e_x + t e_y`, s and t uniform
+// in [-1/2, 1/2]; along the axis its coordinate is the sum of two uniform spreads of half-widths
+// `a` and `b` (the axis components of e_x / 2 and e_y / 2), whose distribution is a trapezoid:
+// rising as a square over `[-(p + q), -(p - q)]`, flat over `|x| <= p - q`, falling as a square
+// to `p + q` (p >= q the larger and smaller half-width). Exact where one texel boundary crosses
+// the footprint; where a texel corner lies inside it, the two axes' shares are multiplied.
+fn share_past(x: f32, a: f32, b: f32) -> f32 {
+    let p = max(max(a, b), 1e-6);
+    let q = min(a, b);
+    let ramp = max(8.0 * p * q, 1e-30);
+    let rising = (x + p + q) * (x + p + q) / ramp;
+    let flat = (x + p) / (2.0 * p);
+    let falling = 1.0 - (p + q - x) * (p + q - x) / ramp;
+    let below = select(select(select(1.0, falling, x < p + q), flat, x <= p - q), rising, x < q - p);
+    return 1.0 - select(below, 0.0, x <= -(p + q));
+}
+
+// B seen through the pixel at `pixel` (its top-left corner is floor(pixel)): the mean of the
+// nearest-texel probe over the pixel's area, as ibl render's footprint (ibl-render footprint.rs)
+// takes it exactly. Where the probe is magnified (the pixel's footprint, linearised from its
+// centre's ray and its two neighbours', has a bounding box at most one texel across: the bundled
+// scenes' whole view but for the poles), the footprint's shares of its at most 2 x 2 texels
+// (share_past) weigh them: 3 rays and 4 reads in place of BACKGROUND_RAYS^2 of each (on lavapipe
+// the 16 rays were a sixth of a frame). Elsewhere (a minified probe, a pole) a BACKGROUND_RAYS x BACKGROUND_RAYS grid
+// of nearest-texel rays; one ray per pixel is the centre's texel.
+fn background(pixel: vec2<f32>, on_plane: bool, p: vec3<f32>, ng: vec3<f32>) -> vec3<f32> {
     if PHOTO_BACKGROUND {
         return photo_pixel(pixel);
     }
-    let n = BACKGROUND_RAYS;
+    let height = dot(p - frame.camera_position.xyz, ng);
     let corner = floor(pixel);
-    let eye = frame.camera_position.xyz;
-    let height = dot(p - eye, ng);
+    let n = BACKGROUND_RAYS;
+    let dims = textureDimensions(probe, 0);
+    let size = vec2<f32>(dims);
+    let centre = corner + 0.5;
+    if n == 1u {
+        return probe_nearest(background_direction(centre, on_plane, p, ng, height));
+    }
+    let c = probe_coords(background_direction(centre, on_plane, p, ng, height), size);
+    var dx = probe_coords(background_direction(centre + vec2<f32>(1.0, 0.0), on_plane, p, ng, height), size) - c;
+    var dy = probe_coords(background_direction(centre + vec2<f32>(0.0, 1.0), on_plane, p, ng, height), size) - c;
+    // Columns wrap: a step across the seam is the short way round.
+    dx.x = dx.x - size.x * round(dx.x / size.x);
+    dy.x = dy.x - size.x * round(dy.x / size.x);
+    let half_box = 0.5 * (abs(dx) + abs(dy));
+    // A loop of 0 or 1 trips rather than an `if`: lavapipe runs a branch's body for a whole block
+    // of pixels under a mask, but skips a loop no pixel of the block enters (shadow_lookup.wgsl).
+    let magnified = all(half_box <= vec2<f32>(0.5));
     var sum = vec3<f32>(0.0);
-    for (var sy = 0u; sy < n; sy = sy + 1u) {
-        for (var sx = 0u; sx < n; sx = sx + 1u) {
+    for (var once = select(0u, 1u, magnified); once > 0u; once = once - 1u) {
+        let first = floor(c - half_box);
+        // The share of the footprint past the boundary between the first texel and the next.
+        let boundary = first + 1.0 - c;
+        let share = vec2<f32>(
+            share_past(boundary.x, 0.5 * abs(dx.x), 0.5 * abs(dy.x)),
+            share_past(boundary.y, 0.5 * abs(dx.y), 0.5 * abs(dy.y)),
+        );
+        let w = i32(dims.x);
+        let h = i32(dims.y);
+        let i0 = ((i32(first.x) % w) + w) % w;
+        let i1 = (i0 + 1) % w;
+        let j0 = clamp(i32(first.y), 0, h - 1);
+        let j1 = clamp(i32(first.y) + 1, 0, h - 1);
+        let top = mix(textureLoad(probe, vec2<i32>(i0, j0), 0).rgb, textureLoad(probe, vec2<i32>(i1, j0), 0).rgb, share.x);
+        let bottom = mix(textureLoad(probe, vec2<i32>(i0, j1), 0).rgb, textureLoad(probe, vec2<i32>(i1, j1), 0).rgb, share.x);
+        sum = mix(top, bottom, share.y) * frame.probe_position.w;
+    }
+    let rays = select(n, 0u, magnified);
+    for (var sy = 0u; sy < rays; sy = sy + 1u) {
+        for (var sx = 0u; sx < rays; sx = sx + 1u) {
             let at = corner + (vec2<f32>(f32(sx), f32(sy)) + 0.5) / f32(n);
-            let d = camera_ray(at);
-            let cos_d = dot(d, ng);
-            // A ray (nearly) parallel to the plane keeps the pixel centre's point.
-            var q = p;
-            if cos_d < -1e-4 {
-                q = eye + d * (height / cos_d);
-            }
-            sum = sum + probe_nearest(normalize(q - frame.probe_position.xyz));
+            sum = sum + probe_nearest(background_direction(at, on_plane, p, ng, height)) / f32(n * n);
         }
     }
-    return sum / f32(n * n);
+    return sum;
 }
 
 // f(wo, wi) cos(theta_i) of a material (ibl-render's Bsdf::eval times the cosine): zero unless
@@ -484,7 +542,7 @@ fn shade_surface(s: Surface, pixel: vec2<f32>, pixel_noise: f32, mask_base: u32)
     if on_virtual {
         return shade_virtual(m, f, wo, sums);
     }
-    let b = background_surface(pixel, s.p, f.ng);
+    let b = background(pixel, true, s.p, f.ng);
     return composite_real(m, s.p, f, wo, b, sums, pixel_noise);
 }
 
@@ -551,7 +609,7 @@ fn fs_shade(in: FullscreenOut) -> FragmentOut {
     }
     var sum = vec3<f32>(0.0);
     if sky > 0.0 {
-        sum = sky * background_sky(pixel);
+        sum = sky * background(pixel, false, vec3<f32>(0.0), vec3<f32>(0.0, 0.0, 1.0));
     }
     for (var g = 0u; g < groups; g = g + 1u) {
         sum = sum + weights[g] * shade_surface(surfaces[g], pixel, pixel_noise, mask_base);

@@ -45,7 +45,8 @@ pub struct SceneFrameSettings {
     pub display: Display,
     /// Glossy reflections.
     pub glossy: GlossySource,
-    /// Background rays per pixel axis (4, as `ibl render`; 1 is faster).
+    /// Background rays per pixel axis where the probe is minified or at a pole (elsewhere the
+    /// pixel's area share of its texels, as `ibl render`); 1: the centre's texel alone.
     pub background_rays: u32,
     /// Shadow map side per light, texels (shrunk when the atlas would be too large).
     pub shadow_tile: u32,

@@ -29,7 +29,9 @@ use ibl_render::lighting::DirectionalLight;
 use ibl_scene::ShadowKind;
 
 use crate::gpu::{DEPTH_FORMAT, GpuContext};
-use crate::gpu_scene::{FACES, GpuLight, GpuPointLight, GpuScene, MAX_POINT_LIGHTS, vec4};
+use crate::gpu_scene::{
+    FACES, GpuLight, GpuPointLight, GpuScene, MAX_POINT_LIGHTS, MeshBuffer, vec4,
+};
 use crate::light_space::{AtlasLayout, ShadowProjection, box_depths};
 use crate::point_lights::{FaceCasters, PointLightInputs, gpu_point_lights};
 use crate::scene_geometry::{VERTEX_ATTRIBUTES, Vertex};
@@ -393,31 +395,30 @@ impl ShadowAtlases {
     ) {
         let bind_group = self.bind_group(gpu, scene);
         let mut pass = Self::pass(encoder, &self.real, "real shadows", timestamps);
-        if scene.real.vertices == 0 {
+        if scene.real.is_empty() {
             return;
         }
         pass.set_pipeline(&self.real_pipeline);
         pass.set_bind_group(0, &bind_group, &[]);
-        pass.set_vertex_buffer(0, scene.real.buffer.slice(..));
+        scene.real.bind(&mut pass);
         let tile = self.real.layout.tile as f32;
         for i in 0..lights.min(self.capacity()) {
             let (x, y) = self.real.layout.origin(i);
             pass.set_viewport(x as f32, y as f32, tile, tile, 0.0, 1.0);
-            pass.draw(0..scene.real.vertices, i..i + 1);
+            scene.real.draw(&mut pass, i..i + 1);
         }
-        self.draw_faces(&mut pass, &self.real, 0, scene.real.vertices, |p| {
-            p.real_faces
-        });
+        self.draw_faces(&mut pass, &self.real, 0, &scene.real, |p| p.real_faces);
     }
 
-    /// Draws one caster (`object` 0 the real geometry, `k + 1` virtual object k) into every
-    /// point-light face of `atlas` that `faces` gives a tile, the viewport set to the tile.
+    /// Draws one caster (`object` 0 the real geometry, `k + 1` virtual object k, its `mesh`
+    /// bound) into every point-light face of `atlas` that `faces` gives a tile, the viewport set
+    /// to the tile.
     fn draw_faces(
         &self,
         pass: &mut wgpu::RenderPass<'_>,
         atlas: &Atlas,
         object: u32,
-        vertices: u32,
+        mesh: &MeshBuffer,
         faces: impl Fn(&GpuPointLight) -> [[f32; 4]; FACES],
     ) {
         let (w, h) = atlas.size();
@@ -441,7 +442,7 @@ impl ShadowAtlases {
                 );
                 let instance =
                     (object * MAX_POINT_LIGHTS as u32 + k as u32) * FACES as u32 + f as u32;
-                pass.draw(0..vertices, instance..instance + 1);
+                mesh.draw(pass, instance..instance + 1);
             }
         }
     }
@@ -467,23 +468,19 @@ impl ShadowAtlases {
         let lights = lights.min(self.capacity());
         pass.set_bind_group(0, &bind_group, &[]);
         for (k, mesh) in scene.objects.iter().enumerate() {
-            if mesh.vertices == 0 {
+            if mesh.is_empty() {
                 continue;
             }
             let object = k as u32 + 1;
-            pass.set_vertex_buffer(0, mesh.buffer.slice(..));
+            mesh.bind(&mut pass);
             if lights > 0 {
                 pass.set_pipeline(&self.virtual_pipeline);
                 pass.set_viewport(0.0, 0.0, w as f32, h as f32, 0.0, 1.0);
-                pass.draw(0..mesh.vertices, object * lights..(object + 1) * lights);
+                mesh.draw(&mut pass, object * lights..(object + 1) * lights);
             }
-            self.draw_faces(
-                &mut pass,
-                &self.virtual_objects,
-                object,
-                mesh.vertices,
-                |p| p.virtual_faces,
-            );
+            self.draw_faces(&mut pass, &self.virtual_objects, object, mesh, |p| {
+                p.virtual_faces
+            });
         }
     }
 }

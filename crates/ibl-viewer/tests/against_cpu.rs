@@ -177,3 +177,72 @@ fn the_lamp_scene_matches_the_cpu_under_the_difference_rule_too() {
         ibl_scene::description::CompositeRule::Difference;
     let _ = compare_model("bunny-lamp-difference", model);
 }
+
+#[test]
+fn the_background_is_each_pixels_area_mean_as_on_the_cpu() {
+    // A coarse probe (32 x 16 texels of unrelated colours, 11.25 degrees each) seen magnified
+    // about 60 times, once across the map and once across the seam where the columns wrap. The
+    // CPU renderer takes each pixel's exact area mean of the nearest-texel probe (ibl-render's
+    // footprint.rs), so a pixel straddling a texel edge shows the edge's share of its area. The
+    // viewer weighs the 2 x 2 texels under the pixel's linearised footprint: exact where one
+    // edge crosses it, the product of the two axes' shares at a texel corner. Measured: mean
+    // absolute difference 1.8e-4 and 1.7e-4, largest 0.004 (colours 0.05 to 0.95; half floats
+    // alone are 5e-4 of 1). A 4 x 4 grid of nearest-texel rays, what the viewer drew before, is
+    // off by up to an eighth of an edge's contrast (measured across the map: mean 1.24e-3,
+    // largest 0.090) and fails both bounds: 5e-4 (about three times the measured mean) and 0.02
+    // (five times the measured largest, a fifth of the grid's).
+    let Some(gpu) = common::gpu_or_skip("background") else {
+        return;
+    };
+    let dir = tempfile::tempdir().expect("temp dir");
+    let probe = Image::from_fn_par(32, 16, |i, j| {
+        let level = |k: usize| 0.05 + 0.9 * ((i * 7 + j * 13 + k * 5) % 11) as f32 / 10.0;
+        Rgb::new(level(0), level(1), level(2))
+    });
+    ibl_io::write_image(
+        &dir.path().join("probe.exr"),
+        &probe,
+        &ibl_io::WriteOptions::default(),
+    )
+    .expect("writes the probe");
+    for (view, look_at) in [
+        ("across the map", "[0.6, 0.35, -1.0]"),
+        ("across the seam", "[0.1, 0.3, 1.0]"),
+    ] {
+        let path = dir.path().join("background.toml");
+        std::fs::write(
+            &path,
+            format!(
+                "version = 1\n[probe]\nfile = \"probe.exr\"\n[camera]\nposition = [0.0, 0.0, 0.0]\n\
+                 look_at = {look_at}\nvertical_fov_deg = 30.0\nimage_size_px = [160, 120]\n"
+            ),
+        )
+        .expect("writes the scene");
+        let model = lights_mode(&path);
+        let options = HeadlessOptions {
+            size: (160, 120),
+            ..Default::default()
+        };
+        let gpu_frame = headless::render_scene(&gpu, &model, &options, &|_, _| {})
+            .expect("gpu renders")
+            .images
+            .radiance;
+        let cpu = ibl_render::background::background_image(&model.scene, 160, 120);
+        let errors: Vec<f32> = gpu_frame
+            .pixels()
+            .iter()
+            .zip(cpu.pixels())
+            .map(|(g, c)| {
+                (g.r - c.r)
+                    .abs()
+                    .max((g.g - c.g).abs())
+                    .max((g.b - c.b).abs())
+            })
+            .collect();
+        let mean = errors.iter().map(|&e| f64::from(e)).sum::<f64>() / errors.len() as f64;
+        let largest = errors.iter().fold(0.0_f32, |m, &e| m.max(e));
+        eprintln!("background {view}: mean absolute difference {mean:.2e}, largest {largest:.3}");
+        assert!(mean <= 5e-4, "{view}: mean absolute difference {mean}");
+        assert!(largest <= 0.02, "{view}: largest difference {largest}");
+    }
+}
