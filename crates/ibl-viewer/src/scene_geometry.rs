@@ -198,31 +198,28 @@ mod tests {
 
     #[test]
     fn shared_vertices_give_back_every_triangle() {
-        // Two triangles sharing an edge, a third with the same corners but another normal, and
-        // one whose corner differs only in its material: 12 corners, 7 distinct vertices.
-        let v = |position: [f32; 3], normal: [f32; 3], material: u32| Vertex {
-            position,
-            normal,
-            material,
-        };
+        // Two triangles sharing an edge, a third on the first's corners with another normal and
+        // a fourth on them in another material: 12 corners, 10 distinct vertices.
         let (a, b, c, d) = ([0.0; 3], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 1.0]);
         let (up, tilted) = ([0.0, 1.0, 0.0], [0.0, 0.6, 0.8]);
-        let corners = [
-            v(a, up, 0),
-            v(b, up, 0),
-            v(c, up, 0),
-            v(b, up, 0),
-            v(d, up, 0),
-            v(c, up, 0),
-            v(a, tilted, 0),
-            v(b, tilted, 0),
-            v(c, tilted, 0),
-            v(a, up, 1),
-            v(b, up, 0),
-            v(c, up, 0),
+        let triangles = [
+            ([a, b, c], up, 0),
+            ([b, d, c], up, 0),
+            ([a, b, c], tilted, 0),
+            ([a, b, c], up, 1),
         ];
+        let corners: Vec<Vertex> = triangles
+            .iter()
+            .flat_map(|&(positions, normal, material)| {
+                positions.map(|position| Vertex {
+                    position,
+                    normal,
+                    material,
+                })
+            })
+            .collect();
         let (kept, indices) = shared_vertices(&corners);
-        assert_eq!(kept.len(), 8);
+        assert_eq!(kept.len(), 10);
         assert_eq!(indices.len(), corners.len());
         let rebuilt: Vec<Vertex> = indices.iter().map(|&i| kept[i as usize]).collect();
         assert_eq!(rebuilt, corners);
