@@ -212,11 +212,12 @@ pub struct GpuScene {
 
 fn mesh(gpu: &GpuContext, label: &str, vertices: &[crate::scene_geometry::Vertex]) -> MeshBuffer {
     let (kept, indices) = crate::scene_geometry::shared_vertices(vertices);
+    let count = indices.len() as u32;
     // wgpu refuses empty buffers: one degenerate vertex and triangle stand in (never drawn).
-    let (kept, stand_in) = if kept.is_empty() {
+    let (kept, indices) = if kept.is_empty() {
         (vec![crate::scene_geometry::Vertex::zeroed()], vec![0; 3])
     } else {
-        (kept, Vec::new())
+        (kept, indices)
     };
     let init = |contents: &[u8], usage, suffix: &str| {
         gpu.device
@@ -233,15 +234,11 @@ fn mesh(gpu: &GpuContext, label: &str, vertices: &[crate::scene_geometry::Vertex
             "vertices",
         ),
         index_buffer: init(
-            bytemuck::cast_slice(if indices.is_empty() {
-                &stand_in
-            } else {
-                &indices
-            }),
+            bytemuck::cast_slice(&indices),
             wgpu::BufferUsages::INDEX,
             "indices",
         ),
-        indices: indices.len() as u32,
+        indices: count,
     }
 }
 

@@ -109,28 +109,26 @@ fn vs_geometry(vertex: Vertex, @builtin(instance_index) object: u32) -> Geometry
     return out;
 }
 
-// CONVENTIONS section 2, as ibl_core::LatLong::dir_to_pixel: the texel holding direction d
-// (probe frame); the column wraps, the row clamps.
-fn probe_texel(d: vec3<f32>, size: vec2<u32>) -> vec2<i32> {
-    let theta = atan2(length(d.xz), d.y);
-    var u = atan2(d.x, -d.z) / (2.0 * PI) + 0.5;
-    u = u - floor(u);
-    let v = theta / PI;
-    let i = min(u32(u * f32(size.x)), size.x - 1u);
-    let j = min(u32(max(v, 0.0) * f32(size.y)), size.y - 1u);
-    return vec2<i32>(i32(i), i32(j));
-}
-
 fn dir_to_uv(d: vec3<f32>) -> vec2<f32> {
     let theta = atan2(length(d.xz), d.y);
     return vec2<f32>(atan2(d.x, -d.z) / (2.0 * PI) + 0.5, theta / PI);
 }
 
-// Nearest probe texel along world direction d.
+// Continuous texel coordinates (column, row; texel (i, j) spans [i, i + 1) x [j, j + 1)) of world
+// direction d in the probe (CONVENTIONS section 2, as ibl_core::LatLong::dir_to_pixel before its
+// rounding); the column wraps.
+fn probe_coords(d: vec3<f32>, size: vec2<f32>) -> vec2<f32> {
+    let local = (frame.probe_from_world * vec4<f32>(d, 0.0)).xyz;
+    let uv = dir_to_uv(local);
+    return vec2<f32>((uv.x - floor(uv.x)) * size.x, uv.y * size.y);
+}
+
+// Nearest probe texel along world direction d (the row clamps).
 fn probe_nearest(d: vec3<f32>) -> vec3<f32> {
     let size = textureDimensions(probe, 0);
-    let local = (frame.probe_from_world * vec4<f32>(d, 0.0)).xyz;
-    return textureLoad(probe, probe_texel(local, size), 0).rgb * frame.probe_position.w;
+    let c = probe_coords(d, vec2<f32>(size));
+    let texel = vec2<u32>(min(u32(c.x), size.x - 1u), min(u32(max(c.y, 0.0)), size.y - 1u));
+    return textureLoad(probe, vec2<i32>(texel), 0).rgb * frame.probe_position.w;
 }
 
 // Filtered probe radiance along world direction d at a mip level of a chain.
@@ -148,14 +146,6 @@ fn camera_ray(px: vec2<f32>) -> vec3<f32> {
 
 fn photo_pixel(pixel: vec2<f32>) -> vec3<f32> {
     return textureLoad(photo, vec2<i32>(pixel), 0).rgb * frame.environment.z;
-}
-
-// Continuous texel coordinates (column, row; texel (i, j) spans [i, i + 1) x [j, j + 1)) of world
-// direction d in the probe, as probe_texel before its rounding.
-fn probe_coords(d: vec3<f32>, size: vec2<f32>) -> vec2<f32> {
-    let local = (frame.probe_from_world * vec4<f32>(d, 0.0)).xyz;
-    let uv = dir_to_uv(local);
-    return vec2<f32>((uv.x - floor(uv.x)) * size.x, uv.y * size.y);
 }
 
 // The direction the background is read along for the camera ray through image point `at`: the
