@@ -176,6 +176,11 @@ pub struct ViewArgs {
     /// unshadowed SH ambient): the objects' sky shadow, one shadow map per light.
     #[arg(long, value_name = "N", default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=64))]
     pub sky_lights: u32,
+    /// Test every light on every real surface instead of only the lights whose virtual shadow
+    /// can reach the pixel's 8 x 8 tile (the same frame, slower; for checking the culling or
+    /// measuring what it saves).
+    #[arg(long)]
+    pub no_light_culling: bool,
     /// Camera yaw over a probe, degrees (0 looks along -Z, positive looks left).
     #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
     pub yaw: Option<f32>,
@@ -296,6 +301,7 @@ pub fn run(args: &ViewArgs, progress: &dyn Progress) -> Result<Option<ViewSummar
             background_rays: args.background_rays,
             display: None,
             sky_lights: args.sky_lights as usize,
+            light_culling: !args.no_light_culling,
         },
         exposure_stops: args.exposure,
         curve: ToneCurve::from(args.tonemap),

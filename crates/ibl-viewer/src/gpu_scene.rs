@@ -208,6 +208,11 @@ pub struct GpuScene {
     pub point_lights: wgpu::Buffer,
     /// The frame uniform.
     pub frame: wgpu::Buffer,
+    /// Each virtual object's cluster spheres, load frame (`caster_cells::cluster_spheres`).
+    pub clusters: Vec<Vec<(glam::Vec3, f32)>>,
+    /// The lights' caster cells (storage, `caster_cells.rs`), [`MAX_SHADOWED_LIGHTS`] lights'
+    /// worth; zero (a caster anywhere: conservative) until written.
+    pub caster_cells: wgpu::Buffer,
 }
 
 fn mesh(gpu: &GpuContext, label: &str, vertices: &[crate::scene_geometry::Vertex]) -> MeshBuffer {
@@ -305,7 +310,41 @@ impl GpuScene {
                 usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             }),
+            clusters: geometry
+                .objects
+                .iter()
+                .map(|o| crate::caster_cells::cluster_spheres(&o.vertices))
+                .collect(),
+            caster_cells: gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("caster cells"),
+                size: (MAX_SHADOWED_LIGHTS * crate::caster_cells::CELLS_PER_LIGHT as usize * 4)
+                    as u64,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
         }
+    }
+
+    /// Writes the caster cells of `lights` (the first [`MAX_SHADOWED_LIGHTS`]) with the virtual
+    /// objects at `placements` (world from load, in object order).
+    pub fn write_caster_cells(
+        &self,
+        gpu: &GpuContext,
+        lights: &[GpuLight],
+        placements: &[Affine3A],
+    ) {
+        let lights = &lights[..lights.len().min(MAX_SHADOWED_LIGHTS)];
+        if lights.is_empty() {
+            return;
+        }
+        let objects: Vec<(Affine3A, &[(glam::Vec3, f32)])> = placements
+            .iter()
+            .zip(&self.clusters)
+            .map(|(&m, c)| (m, &c[..]))
+            .collect();
+        let cells = crate::caster_cells::caster_cells(lights, &objects);
+        gpu.queue
+            .write_buffer(&self.caster_cells, 0, bytemuck::cast_slice(&cells));
     }
 
     /// Writes the lights (the first [`MAX_SHADOWED_LIGHTS`]; `lighting.rs` refuses more).

@@ -140,6 +140,16 @@ fn point_at_depth(pixel: vec2<f32>, depth: f32) -> vec3<f32> {
 }
 
 // Samples per pixel of the scene's geometry pass (frame_targets.rs's MSAA_SAMPLES).
+// The inverse of scene_pass.wgsl's oct_encode: a unit vector from its octahedral code (the
+// geometry pass's normals).
+fn oct_decode(e: vec2<f32>) -> vec3<f32> {
+    var n = vec3<f32>(e, 1.0 - abs(e.x) - abs(e.y));
+    if n.z < 0.0 {
+        n = vec3<f32>((1.0 - abs(n.yx)) * select(vec2<f32>(-1.0), vec2<f32>(1.0), n.xy >= vec2<f32>(0.0)), n.z);
+    }
+    return normalize(n);
+}
+
 const GBUFFER_SAMPLES: u32 = 4u;
 
 // The light masks of light_tiles.wgsl: per LIGHT_TILE x LIGHT_TILE pixel tile, LIGHT_WORDS

@@ -59,6 +59,8 @@ pub struct HeadlessOptions {
     /// An outdoor sequence's sky as this many shadowed lights (0: the unshadowed ambient;
     /// [`SequencePlayer::sky_lights`]).
     pub sky_lights: usize,
+    /// Per-tile light culling on real surfaces ([`SceneFrameSettings::light_culling`]).
+    pub light_culling: bool,
 }
 
 impl Default for HeadlessOptions {
@@ -72,6 +74,7 @@ impl Default for HeadlessOptions {
             background_rays: 4,
             display: None,
             sky_lights: 0,
+            light_culling: true,
         }
     }
 }
@@ -285,6 +288,7 @@ pub fn render_scene_lit(
             background_rays: options.background_rays,
             shadow_tile: options.shadow_tile,
             selected: None,
+            light_culling: options.light_culling,
         };
         let started = Instant::now();
         let report = renderer.render(gpu, &moving, &settings);
@@ -339,6 +343,7 @@ pub fn render_sequence(
         background_rays: options.background_rays,
         shadow_tile: options.shadow_tile,
         selected: None,
+        light_culling: options.light_culling,
     };
     let frames = options.frames.max(1) as usize;
     let mut timings = Vec::with_capacity(frames);

@@ -41,6 +41,7 @@
 //! replaces it by a 3-D texture read at the shading point), and the worker recomputes either off
 //! the UI thread.
 
+pub mod caster_cells;
 pub mod command_line;
 pub mod demo_frames;
 pub mod display_pass;

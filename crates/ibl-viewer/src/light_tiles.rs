@@ -1,6 +1,7 @@
 //! Light culling per screen tile for the real layer (`light_tiles.wgsl`): between the scene's
 //! geometry and shading passes, a compute pass marks, for each 8 x 8 pixel tile, the lights
-//! whose virtual-object shadow can reach the tile's real surfaces. A real surface is changed
+//! whose virtual-object shadow can reach the tile's real surfaces (against each light's caster
+//! cells, `caster_cells.rs`). A real surface is changed
 //! only by those lights (the composite's `with - without`), so the shading pass loops over
 //! them alone; a virtual object still takes every light. The test is conservative: the frame is
 //! the same as with every light tested per pixel (the GPU-against-CPU checks in
@@ -79,6 +80,8 @@ impl LightTiles {
                 samples(2),
                 samples(3),
                 buffer(4, wgpu::BufferBindingType::Storage { read_only: false }),
+                buffer(5, wgpu::BufferBindingType::Storage { read_only: true }),
+                samples(6),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -97,7 +100,7 @@ impl LightTiles {
         LightTiles { pipeline, layout }
     }
 
-    /// The bind group of a scene's lights, the geometry pass's samples (`FrameTargets::gbuffer`)
+    /// The bind group of a scene's lights and caster cells, the geometry pass's samples (`FrameTargets::gbuffer`)
     /// and the mask buffer (`FrameTargets::light_masks`).
     pub fn bind_group(
         &self,
@@ -130,6 +133,14 @@ impl LightTiles {
                 wgpu::BindGroupEntry {
                     binding: 4,
                     resource: masks.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 5,
+                    resource: scene.caster_cells.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 6,
+                    resource: view(&gbuffer[2]),
                 },
             ],
         })

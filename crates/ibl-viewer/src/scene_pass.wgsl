@@ -453,14 +453,6 @@ fn oct_encode(n: vec3<f32>) -> vec2<f32> {
     return (1.0 - abs(q.yx)) * select(vec2<f32>(-1.0), vec2<f32>(1.0), q >= vec2<f32>(0.0));
 }
 
-fn oct_decode(e: vec2<f32>) -> vec3<f32> {
-    var n = vec3<f32>(e, 1.0 - abs(e.x) - abs(e.y));
-    if n.z < 0.0 {
-        n = vec3<f32>((1.0 - abs(n.yx)) * select(vec2<f32>(-1.0), vec2<f32>(1.0), n.xy >= vec2<f32>(0.0)), n.z);
-    }
-    return normalize(n);
-}
-
 struct GBufferOut {
     @location(0) depth: vec4<f32>,
     @location(1) id: vec4<f32>,

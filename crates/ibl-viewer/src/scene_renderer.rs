@@ -52,6 +52,9 @@ pub struct SceneFrameSettings {
     pub shadow_tile: u32,
     /// The selected object (tinted in the overlay).
     pub selected: Option<usize>,
+    /// Real surfaces take only their screen tile's lights (`light_tiles.rs`; the same frame,
+    /// faster); false tests every light on every real pixel (for checking the culling).
+    pub light_culling: bool,
 }
 
 /// What a frame did.
@@ -354,7 +357,7 @@ impl SceneRenderer {
         occlusion_gather: bool,
     ) -> ShaderVariant {
         ShaderVariant {
-            tiled_lights: lights >= crate::light_tiles::MIN_TILED_LIGHTS,
+            tiled_lights: settings.light_culling && lights >= crate::light_tiles::MIN_TILED_LIGHTS,
             soft_shadows: model.description.lighting.shadows == ibl_scene::ShadowKind::Soft,
             ratio_rule: model.description.render.composite == CompositeRule::Ratio,
             photo_background: matches!(model.scene.background, Background::Photo(_)),
@@ -433,6 +436,8 @@ impl SceneRenderer {
             );
             draw_real |= region_moved;
             self.gpu_scene.write_lights(gpu, &gpu_lights);
+            self.gpu_scene
+                .write_caster_cells(gpu, &gpu_lights, &placements);
             self.gpu_scene
                 .write_point_lights(gpu, self.shadows.point_lights());
             self.gpu_lights = gpu_lights;

@@ -436,6 +436,7 @@ impl Content {
                     background_rays: s.background_rays,
                     shadow_tile: s.shadow_tile,
                     selected: s.selected,
+                    light_culling: true,
                 };
                 s.renderer.render(gpu, &s.model, &settings);
                 let _ = s.renderer.read_pass_times(gpu, false);
