@@ -184,7 +184,7 @@ mod tests {
         assert_eq!(level_offset(0), 0);
         assert_eq!(level_offset(1), 1024);
         assert_eq!(level_offset(LEVELS - 1), CELLS_PER_LIGHT - 1);
-        let source = include_str!("light_tiles.wgsl");
+        let source = include_str!("caster_cells.wgsl");
         assert!(source.contains(&format!("const CASTER_GRID: u32 = {GRID}u;")));
         assert!(source.contains(&format!("const CASTER_LEVELS: u32 = {LEVELS}u;")));
         assert!(source.contains(&format!("const CASTER_CELLS: u32 = {CELLS_PER_LIGHT}u;")));

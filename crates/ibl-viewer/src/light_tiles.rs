@@ -43,8 +43,9 @@ impl LightTiles {
     pub fn new(gpu: &GpuContext) -> LightTiles {
         let device = &gpu.device;
         let source = format!(
-            "{}\n{}",
+            "{}\n{}\n{}",
             include_str!("gpu_scene.wgsl"),
+            include_str!("caster_cells.wgsl"),
             include_str!("light_tiles.wgsl")
         );
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {

@@ -16,19 +16,8 @@
 @group(0) @binding(4) var<storage, read_write> masks: array<u32>;
 @group(0) @binding(6) var gbuffer_normals: texture_multisampled_2d<f32>;
 
-// The caster cells of every light (caster_cells.rs): per light a CASTER_GRID x CASTER_GRID grid
-// over its virtual tile and its min-pyramid, CASTER_CELLS in all, each holding the nearest depth
-// (world units from the tile's near plane) a caster drawn into the cell can have.
+// The caster cells of every light (caster_cells.wgsl).
 @group(0) @binding(5) var<storage, read> caster_cells: array<f32>;
-
-const CASTER_GRID: u32 = 32u;
-const CASTER_LEVELS: u32 = 6u;
-const CASTER_CELLS: u32 = 1365u;
-
-// First cell of pyramid level `level` within a light's cells (caster_cells.rs's level_offset).
-fn level_offset(level: u32) -> u32 {
-    return ((1u << (2u * CASTER_LEVELS)) - (1u << (2u * (CASTER_LEVELS - level)))) / 3u;
-}
 
 // Whether light i's virtual-object shadow can reach a tile's real points, which lie in the box
 // (lo, hi). A receiver sees a caster through its hard tap within the look-up's normal offset (at
@@ -57,26 +46,7 @@ fn reaches(i: u32, lo: vec3<f32>, hi: vec3<f32>) -> bool {
     }
     let search = min(min(deepest, e.y) * lights[i].direction.w, 0.25 * e.x);
     let reach = (margin + search) / e.x;
-    let low = max(near.xy - reach, vec2<f32>(-1.0));
-    let high = min(far.xy + reach, vec2<f32>(1.0));
-    if any(low > high) {
-        return false;
-    }
-    let width = 0.5 * f32(CASTER_GRID) * max(high.x - low.x, high.y - low.y);
-    let level = 0u;
-    let n = CASTER_GRID >> level;
-    let last = vec2<f32>(f32(n - 1u));
-    let c0 = vec2<u32>(clamp(floor((low + 1.0) * (0.5 * f32(n))), vec2<f32>(0.0), last));
-    let c1 = vec2<u32>(clamp(floor((high + 1.0) * (0.5 * f32(n))), vec2<f32>(0.0), last));
-    let base = i * CASTER_CELLS + level_offset(level);
-    for (var y = c0.y; y <= c1.y; y = y + 1u) {
-        for (var x = c0.x; x <= c1.x; x = x + 1u) {
-            if caster_cells[base + y * n + x] < deepest {
-                return true;
-            }
-        }
-    }
-    return false;
+    return caster_within(i, near.xy - reach, far.xy + reach, deepest, 3.0);
 }
 
 // Whether some normal in the box (lo, hi) faces light i: the largest `n . w` over the box is
