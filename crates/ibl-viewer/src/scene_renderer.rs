@@ -150,7 +150,7 @@ impl SceneRenderer {
         let gpu_scene = GpuScene::new(gpu, &model.geometry);
         let environment = EnvironmentMaps::new(gpu, &model.scene.probe.radiance);
         let scene_pass = ScenePass::new(gpu);
-        let shadows = ShadowAtlases::new(gpu, 1, shadow_tile);
+        let shadows = ShadowAtlases::new(gpu, 1, shadow_tile, false);
         let ambient = black_texture(&gpu.device, &gpu.queue, "no ambient");
         let photo = photo_texture(gpu, model, None, width, height);
         let intensity = black_texture(&gpu.device, &gpu.queue, "no point lights");
@@ -400,8 +400,10 @@ impl SceneRenderer {
             settings.shadow_tile,
             gpu.max_texture_side(),
         );
-        if wanted != self.shadows.real.layout {
-            self.shadows = ShadowAtlases::new(gpu, tiles, settings.shadow_tile);
+        if wanted != self.shadows.real.layout
+            || ShadowAtlases::virtual_format(points > 0) != self.shadows.virtual_objects.format
+        {
+            self.shadows = ShadowAtlases::new(gpu, tiles, settings.shadow_tile, points > 0);
             self.lights_changed = true;
             self.rebind(gpu);
         }

@@ -23,12 +23,24 @@
 //! Goniometric point lights take six tiles each after the directional lights' (their cube
 //! faces, `point_lights.rs`), drawn with the same rules: the real faces when the lights change,
 //! the virtual ones when an object moves, and only the faces that see casters.
+//!
+//! Depth formats: the real atlas is `Depth32Float` (its slab spans the whole real geometry, and a
+//! point light's perspective faces need a float's resolution near their far plane). Without
+//! point lights the virtual atlas is `Depth16Unorm`: its orthographic slab spans only the
+//! objects' bounding sphere, so 16 bits resolve 2^-16 of the objects' diameter, 64 times finer
+//! than the look-up's smallest depth bias at the default 1024-texel tiles (a texel's width over
+//! the slab, at least 1.05 / 1024 of it; 16 times at 4096-texel tiles). Half the bytes make the shading pass's PCSS taps cheaper on a CPU rasterizer (lavapipe:
+//! 5 % of bunny-sky's frame, BENCHMARKS.md "Round 6"). With point lights it is
+//! `Depth32Float`, as their faces share its texture.
 
 use glam::Vec3;
 use ibl_render::lighting::DirectionalLight;
 use ibl_scene::ShadowKind;
 
 use crate::gpu::{DEPTH_FORMAT, GpuContext};
+
+/// The virtual atlas's depth format in a scene without point lights (module notes).
+pub const VIRTUAL_DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth16Unorm;
 use crate::gpu_scene::{
     FACES, GpuLight, GpuPointLight, GpuScene, MAX_POINT_LIGHTS, MeshBuffer, vec4,
 };
@@ -46,12 +58,19 @@ pub struct Atlas {
     pub layout: AtlasLayout,
     /// The depth texture.
     pub texture: wgpu::Texture,
+    /// Its format.
+    pub format: wgpu::TextureFormat,
     /// A view of it.
     pub view: wgpu::TextureView,
 }
 
 impl Atlas {
-    fn new(gpu: &GpuContext, label: &str, layout: AtlasLayout) -> Atlas {
+    fn new(
+        gpu: &GpuContext,
+        label: &str,
+        layout: AtlasLayout,
+        format: wgpu::TextureFormat,
+    ) -> Atlas {
         let (w, h) = layout.size();
         let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
             label: Some(label),
@@ -63,7 +82,7 @@ impl Atlas {
             mip_level_count: 1,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
-            format: DEPTH_FORMAT,
+            format,
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
             view_formats: &[],
         });
@@ -71,6 +90,7 @@ impl Atlas {
         Atlas {
             layout,
             texture,
+            format,
             view,
         }
     }
@@ -138,8 +158,9 @@ pub struct ShadowAtlases {
 
 impl ShadowAtlases {
     /// Atlases of `tiles` tiles (a directional light takes one, a point light [`FACES`]) of
-    /// `tile` texels each (shrunk to fit the device).
-    pub fn new(gpu: &GpuContext, tiles: u32, tile: u32) -> ShadowAtlases {
+    /// `tile` texels each (shrunk to fit the device), for a scene with or without
+    /// `point_lights` (the virtual atlas's format: [`ShadowAtlases::virtual_format`]).
+    pub fn new(gpu: &GpuContext, tiles: u32, tile: u32, point_lights: bool) -> ShadowAtlases {
         let layout = AtlasLayout::new(tiles, tile, gpu.max_texture_side());
         let device = &gpu.device;
         let source = format!(
@@ -197,7 +218,7 @@ impl ShadowAtlases {
             bind_group_layouts: &[Some(&bind_layout)],
             immediate_size: 0,
         });
-        let pipeline = |entry: &str| {
+        let pipeline = |entry: &str, format: wgpu::TextureFormat| {
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some(entry),
                 layout: Some(&pipeline_layout),
@@ -216,7 +237,7 @@ impl ShadowAtlases {
                     ..Default::default()
                 },
                 depth_stencil: Some(wgpu::DepthStencilState {
-                    format: DEPTH_FORMAT,
+                    format,
                     depth_write_enabled: Some(true),
                     depth_compare: Some(wgpu::CompareFunction::Less),
                     stencil: wgpu::StencilState::default(),
@@ -228,12 +249,14 @@ impl ShadowAtlases {
                 cache: None,
             })
         };
+        let virtual_format = ShadowAtlases::virtual_format(point_lights);
         ShadowAtlases {
-            real: Atlas::new(gpu, "real shadow atlas", layout),
-            virtual_objects: Atlas::new(gpu, "virtual shadow atlas", layout),
-            real_pipeline: pipeline("vs_real_tile"),
-            virtual_pipeline: pipeline("vs_virtual_atlas"),
-            face_pipeline: pipeline("vs_point_face"),
+            real: Atlas::new(gpu, "real shadow atlas", layout, DEPTH_FORMAT),
+            virtual_objects: Atlas::new(gpu, "virtual shadow atlas", layout, virtual_format),
+            real_pipeline: pipeline("vs_real_tile", DEPTH_FORMAT),
+            virtual_pipeline: pipeline("vs_virtual_atlas", virtual_format),
+            // Drawn into both atlases, which with point lights share the format.
+            face_pipeline: pipeline("vs_point_face", DEPTH_FORMAT),
             bind_layout,
             points: Vec::new(),
             region: None,
@@ -248,6 +271,15 @@ impl ShadowAtlases {
     /// How many tiles the atlases hold.
     pub fn capacity(&self) -> u32 {
         self.real.layout.tiles
+    }
+
+    /// The virtual atlas's depth format for a scene with or without point lights (module notes).
+    pub fn virtual_format(point_lights: bool) -> wgpu::TextureFormat {
+        if point_lights {
+            DEPTH_FORMAT
+        } else {
+            VIRTUAL_DEPTH_FORMAT
+        }
     }
 
     /// Tiles for `lights` directional and `points` point lights.
