@@ -14,7 +14,7 @@
 //! sphere alone, which kept a light wherever the widest possible penumbra search around the whole
 //! sphere reached: on bunny-sky (16 soft lights, 640 x 480) the real surfaces looped over 1.79 M
 //! pixel-lights, and the blocker search found a caster for 0.34 M of them. Against the cells (and
-//! the tile's normals: `light_tiles.wgsl`'s `faces`) they loop over 1.17 M (BENCHMARKS.md,
+//! the tile's normals: `light_tiles.wgsl`'s `faces`) they loop over 1.25 M (BENCHMARKS.md,
 //! "Round 6").
 //!
 //! Cost: per light and cluster one projection and the cells it covers, then the pyramids, on the

@@ -4,10 +4,9 @@
 // On a real surface the scene pass needs only the lights whose shadow the virtual objects can
 // cast there (difference and ratio rules alike: the change `with - without` is 0 elsewhere).
 // A light is kept for a tile when the box of the tile's real samples can see a caster through
-// the shadow look-up (`reaches`, against the light's caster cells).
-// Conservative, so the composite is unchanged; the
-// shading pass then loops over a tile's own lights, the same count for every pixel of the tile,
-// instead of testing every light per pixel.
+// the shadow look-up (`reaches`, against the light's caster cells). Conservative, so the
+// composite is unchanged; the shading pass then loops over a tile's own lights, the same count
+// for every pixel of the tile, instead of testing every light per pixel.
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<uniform> lights: array<Light, MAX_SHADOWED_LIGHTS>;
@@ -21,7 +20,8 @@
 
 // Whether light i's virtual-object shadow can reach a tile's real points, which lie in the box
 // (lo, hi). A receiver sees a caster through its hard tap within the look-up's normal offset (at
-// most 3.5 texels: tile_hit) and through PCSS's blocker search within the search radius,
+// most 3.5 texels: tile_hit) and the tap's bilinear footprint (a texel) and clamp (half a
+// texel), a margin of 6 texels, and through PCSS's blocker search within the search radius,
 // `receiver depth x tan(half angle)` from the tile's near plane, at most a quarter of the tile's
 // half extent (soft_visibility); without a blocker found the filter does not run, so no wider
 // penumbra can reach further; only casters in front of the receiver block it. So the light is
@@ -39,7 +39,7 @@ fn reaches(i: u32, lo: vec3<f32>, hi: vec3<f32>) -> bool {
         near = min(near, q);
         far = max(far, q);
     }
-    let margin = 4.0 * e.z;
+    let margin = 6.0 * e.z;
     let deepest = far.z * e.y + margin;
     if deepest <= 0.0 {
         return false;
