@@ -21,9 +21,9 @@
 //! CPU each frame the objects move or the lights change (bunny-patches, 32 lights: 1.1 ms a
 //! frame), and 5.5 KiB a light uploaded.
 
-use glam::{Affine3A, Mat4, Vec2, Vec3};
+use glam::{Affine3A, Vec2, Vec3};
 
-use crate::gpu_scene::GpuLight;
+use crate::light_space::ShadowProjection;
 use crate::scene_geometry::Vertex;
 
 /// Cells across one light's grid at the finest level (`light_tiles.wgsl`'s `CASTER_GRID`).
@@ -80,7 +80,7 @@ pub fn cluster_spheres(vertices: &[Vertex]) -> Vec<(Vec3, f32)> {
     boxes
         .into_iter()
         .filter(|(lo, hi)| lo.x <= hi.x)
-        .map(|(lo, hi)| crate::shadow_atlas::bounding_sphere(lo, hi))
+        .map(|(lo, hi)| (0.5 * (lo + hi), 0.5 * (hi - lo).length()))
         .collect()
 }
 
@@ -102,10 +102,13 @@ fn stretch(m: &Affine3A) -> f32 {
     if orthogonal { columns } else { frobenius }
 }
 
-/// The cells of every light (`lights`, each with its virtual tile's map and extent), light after
+/// The cells of every light (`lights`: each light's virtual tile, its projection), light after
 /// light, [`CELLS_PER_LIGHT`] each, from the clusters of each object (`objects`: the object's
 /// world-from-load placement and its [`cluster_spheres`]).
-pub fn caster_cells(lights: &[GpuLight], objects: &[(Affine3A, &[(Vec3, f32)])]) -> Vec<f32> {
+pub fn caster_cells(
+    lights: &[ShadowProjection],
+    objects: &[(Affine3A, &[(Vec3, f32)])],
+) -> Vec<f32> {
     let spheres: Vec<(Vec3, f32)> = objects
         .iter()
         .flat_map(|(m, clusters)| {
@@ -120,9 +123,9 @@ pub fn caster_cells(lights: &[GpuLight], objects: &[(Affine3A, &[(Vec3, f32)])])
         .iter()
         .zip(cells.chunks_exact_mut(CELLS_PER_LIGHT as usize))
     {
-        let map = Mat4::from_cols_array_2d(&light.virtual_map);
-        let half_extent = light.virtual_extent[0];
-        let depth_range = light.virtual_extent[1];
+        let map = light.map_from_world;
+        let half_extent = light.half_extent;
+        let depth_range = light.depth_range;
         let n = GRID as f32;
         let cell = |x: f32| ((x + 1.0) * 0.5 * n).floor().clamp(0.0, n - 1.0) as usize;
         for &(centre, radius) in &spheres {
@@ -166,8 +169,6 @@ pub fn caster_cells(lights: &[GpuLight], objects: &[(Affine3A, &[(Vec3, f32)])])
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::light_space::ShadowProjection;
-    use bytemuck::Zeroable;
 
     fn vertex(p: Vec3) -> Vertex {
         Vertex {
@@ -233,9 +234,7 @@ mod tests {
         // of radius 0.1 at (0.5, 0.2, 0) and (-0.5, 0.6, 0).
         let w = Vec3::Y;
         let projection = ShadowProjection::around_sphere(w, Vec3::ZERO, 1.0, 1.0);
-        let mut light = GpuLight::zeroed();
-        light.virtual_map = projection.map_from_world.to_cols_array_2d();
-        light.virtual_extent = [projection.half_extent, projection.depth_range, 0.0, 0.0];
+        let light = projection;
         let clusters = [
             (Vec3::new(0.5, 0.2, 0.0), 0.1),
             (Vec3::new(-0.5, 0.6, 0.0), 0.1),

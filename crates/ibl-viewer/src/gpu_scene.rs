@@ -337,12 +337,20 @@ impl GpuScene {
         if lights.is_empty() {
             return;
         }
+        let tiles: Vec<crate::light_space::ShadowProjection> = lights
+            .iter()
+            .map(|l| crate::light_space::ShadowProjection {
+                map_from_world: glam::Mat4::from_cols_array_2d(&l.virtual_map),
+                half_extent: l.virtual_extent[0],
+                depth_range: l.virtual_extent[1],
+            })
+            .collect();
         let objects: Vec<(Affine3A, &[(glam::Vec3, f32)])> = placements
             .iter()
             .zip(&self.clusters)
             .map(|(&m, c)| (m, &c[..]))
             .collect();
-        let cells = crate::caster_cells::caster_cells(lights, &objects);
+        let cells = crate::caster_cells::caster_cells(&tiles, &objects);
         gpu.queue
             .write_buffer(&self.caster_cells, 0, bytemuck::cast_slice(&cells));
     }
