@@ -23,7 +23,7 @@
 
 use glam::{Affine3A, Vec2, Vec3};
 
-use crate::light_space::ShadowProjection;
+use crate::light_space::{ShadowProjection, bounding_sphere};
 use crate::scene_geometry::Vertex;
 
 /// Cells across one light's grid at the finest level (`light_tiles.wgsl`'s `CASTER_GRID`).
@@ -46,7 +46,7 @@ pub fn level_offset(level: u32) -> u32 {
 
 /// Bounding spheres `(centre, radius)`, load frame, of clusters of an object's triangles
 /// (`vertices`, three per triangle): the triangles are grouped by the cell of their centroid in
-/// a grid of up to 8 x 8 x 8 cells over the object's bounds (fewer for small meshes, about
+/// a grid of up to 12 x 12 x 12 cells over the object's bounds (fewer for small meshes, about
 /// [`TRIANGLES_PER_CLUSTER`] triangles each), and each non-empty group is bounded by the sphere
 /// around its corners' box. Every corner lies in its group's sphere. O(T).
 pub fn cluster_spheres(vertices: &[Vertex]) -> Vec<(Vec3, f32)> {
@@ -80,7 +80,7 @@ pub fn cluster_spheres(vertices: &[Vertex]) -> Vec<(Vec3, f32)> {
     boxes
         .into_iter()
         .filter(|(lo, hi)| lo.x <= hi.x)
-        .map(|(lo, hi)| (0.5 * (lo + hi), 0.5 * (hi - lo).length()))
+        .map(|(lo, hi)| bounding_sphere(lo, hi))
         .collect()
 }
 
@@ -193,7 +193,7 @@ mod tests {
 
     #[test]
     fn every_corner_lies_in_its_clusters_sphere() {
-        // A bumpy grid of 40 x 40 quads: clusters of about 16 triangles.
+        // A bumpy grid of 40 x 40 quads: clusters of about TRIANGLES_PER_CLUSTER triangles.
         let mut v = Vec::new();
         let h =
             |i: usize, j: usize| Vec3::new(i as f32, ((i * 7 + j * 3) % 5) as f32 * 0.1, j as f32);
@@ -233,8 +233,7 @@ mod tests {
         // A light from straight above, its tile around the unit sphere at the origin; clusters
         // of radius 0.1 at (0.5, 0.2, 0) and (-0.5, 0.6, 0).
         let w = Vec3::Y;
-        let projection = ShadowProjection::around_sphere(w, Vec3::ZERO, 1.0, 1.0);
-        let light = projection;
+        let light = ShadowProjection::around_sphere(w, Vec3::ZERO, 1.0, 1.0);
         let clusters = [
             (Vec3::new(0.5, 0.2, 0.0), 0.1),
             (Vec3::new(-0.5, 0.6, 0.0), 0.1),
@@ -253,7 +252,7 @@ mod tests {
         // Each sphere covers a square 0.2 / 2 of the tile across: 3 to 5 cells a side.
         assert!((2 * 9..=2 * 25).contains(&filled), "{filled}");
         // Every cell a sphere's projection covers is filled with a depth no deeper than its front.
-        let p = projection.project(Vec3::new(0.5, 0.2, 0.0));
+        let p = light.project(Vec3::new(0.5, 0.2, 0.0));
         let cell = |x: f32| ((x + 1.0) * 0.5 * GRID as f32).floor() as usize;
         let c = cells[cell(p.y) * GRID as usize + cell(p.x)];
         assert!((c - 0.7).abs() < 1e-5, "{c}");

@@ -139,7 +139,6 @@ fn point_at_depth(pixel: vec2<f32>, depth: f32) -> vec3<f32> {
     return frame.camera_position.xyz + (frame.world_from_camera * vec4<f32>(d, 0.0)).xyz * depth;
 }
 
-// Samples per pixel of the scene's geometry pass (frame_targets.rs's MSAA_SAMPLES).
 // The inverse of scene_pass.wgsl's oct_encode: a unit vector from its octahedral code (the
 // geometry pass's normals).
 fn oct_decode(e: vec2<f32>) -> vec3<f32> {
@@ -150,6 +149,7 @@ fn oct_decode(e: vec2<f32>) -> vec3<f32> {
     return normalize(n);
 }
 
+// Samples per pixel of the scene's geometry pass (frame_targets.rs's MSAA_SAMPLES).
 const GBUFFER_SAMPLES: u32 = 4u;
 
 // The light masks of light_tiles.wgsl: per LIGHT_TILE x LIGHT_TILE pixel tile, LIGHT_WORDS

@@ -97,6 +97,11 @@ impl ShadowProjection {
     }
 }
 
+/// The sphere `(centre, radius)` enclosing a box.
+pub fn bounding_sphere(lo: Vec3, hi: Vec3) -> (Vec3, f32) {
+    ((lo + hi) * 0.5, ((hi - lo) * 0.5).length().max(1e-4))
+}
+
 /// Extents along `w` of the box `(lo, hi)` about `centre`: `(toward_light, away_from_light)`, the
 /// largest distances of its corners in front of and behind `centre` along `w` (at least 0).
 pub fn box_depths(w: Vec3, centre: Vec3, lo: Vec3, hi: Vec3) -> (f32, f32) {

@@ -1,10 +1,10 @@
 //! Light culling per screen tile for the real layer (`light_tiles.wgsl`): between the scene's
 //! geometry and shading passes, a compute pass marks, for each 8 x 8 pixel tile, the lights
 //! whose virtual-object shadow can reach the tile's real surfaces (against each light's caster
-//! cells, `caster_cells.rs`). A real surface is changed
-//! only by those lights (the composite's `with - without`), so the shading pass loops over
-//! them alone; a virtual object still takes every light. The test is conservative: the frame is
-//! the same as with every light tested per pixel (the GPU-against-CPU checks in
+//! cells, `caster_cells.rs`). A real surface is changed only by those lights (the composite's
+//! `with - without`), so the shading pass loops over them alone; a virtual object still takes
+//! every light. The test is conservative: the frame is the same as with every light tested per
+//! pixel (`tests/light_culling.rs` compares the two; the GPU-against-CPU checks in
 //! `tests/against_cpu.rs` run through it).
 
 use crate::gpu::GpuContext;
@@ -101,8 +101,8 @@ impl LightTiles {
         LightTiles { pipeline, layout }
     }
 
-    /// The bind group of a scene's lights and caster cells, the geometry pass's samples (`FrameTargets::gbuffer`)
-    /// and the mask buffer (`FrameTargets::light_masks`).
+    /// The bind group of a scene's lights and caster cells, the geometry pass's samples
+    /// (`FrameTargets::gbuffer`) and the mask buffer (`FrameTargets::light_masks`).
     pub fn bind_group(
         &self,
         gpu: &GpuContext,

@@ -166,7 +166,7 @@ impl SceneModel {
                 hi = hi.max(p);
             }
         }
-        (lo.x <= hi.x).then(|| crate::shadow_atlas::bounding_sphere(lo, hi))
+        (lo.x <= hi.x).then(|| crate::light_space::bounding_sphere(lo, hi))
     }
 
     /// The materials of every triangle slot as edited (real first, then each object's).

@@ -416,7 +416,7 @@ impl SceneRenderer {
                 model
                     .geometry
                     .real_bounds()
-                    .map(|(lo, hi)| crate::shadow_atlas::bounding_sphere(lo, hi))
+                    .map(|(lo, hi)| crate::light_space::bounding_sphere(lo, hi))
             })
             .unwrap_or((Vec3::ZERO, 1.0));
         let moved = self.drawn_placements.as_ref() != Some(&placements);

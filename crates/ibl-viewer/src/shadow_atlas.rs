@@ -29,24 +29,25 @@
 //! point lights the virtual atlas is `Depth16Unorm`: its orthographic slab spans only the
 //! objects' bounding sphere, so 16 bits resolve 2^-16 of the objects' diameter, 64 times finer
 //! than the look-up's smallest depth bias at the default 1024-texel tiles (a texel's width over
-//! the slab, at least 1.05 / 1024 of it; 16 times at 4096-texel tiles). Half the bytes make the shading pass's PCSS taps cheaper on a CPU rasterizer (lavapipe:
-//! 5 % of bunny-sky's frame, BENCHMARKS.md "Round 6"). With point lights it is
-//! `Depth32Float`, as their faces share its texture.
+//! the slab, at least 1.05 / 1024 of it; 16 times at 4096-texel tiles). Half the bytes make the
+//! shading pass's PCSS taps cheaper on a CPU rasterizer (lavapipe: 5 % of bunny-sky's frame,
+//! BENCHMARKS.md "Round 6"). With point lights it is `Depth32Float`, as their faces share its
+//! texture.
 
 use glam::Vec3;
 use ibl_render::lighting::DirectionalLight;
 use ibl_scene::ShadowKind;
 
 use crate::gpu::{DEPTH_FORMAT, GpuContext};
-
-/// The virtual atlas's depth format in a scene without point lights (module notes).
-pub const VIRTUAL_DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth16Unorm;
 use crate::gpu_scene::{
     FACES, GpuLight, GpuPointLight, GpuScene, MAX_POINT_LIGHTS, MeshBuffer, vec4,
 };
-use crate::light_space::{AtlasLayout, ShadowProjection, box_depths};
+use crate::light_space::{AtlasLayout, ShadowProjection, bounding_sphere, box_depths};
 use crate::point_lights::{FaceCasters, PointLightInputs, gpu_point_lights};
 use crate::scene_geometry::{VERTEX_ATTRIBUTES, Vertex};
+
+/// The virtual atlas's depth format in a scene without point lights (module notes).
+pub const VIRTUAL_DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth16Unorm;
 
 /// The real atlas covers this many times the virtual objects' bounding radius about them.
 pub const REGION_FACTOR: f32 = 4.0;
@@ -99,11 +100,6 @@ impl Atlas {
     pub fn size(&self) -> (u32, u32) {
         self.layout.size()
     }
-}
-
-/// The sphere `(centre, radius)` enclosing a box.
-pub fn bounding_sphere(lo: Vec3, hi: Vec3) -> (Vec3, f32) {
-    ((lo + hi) * 0.5, ((hi - lo) * 0.5).length().max(1e-4))
 }
 
 /// Tan of a light's cone half-angle (0 for a point-like light), capped at 10 (84 degrees).

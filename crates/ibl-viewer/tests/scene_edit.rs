@@ -103,7 +103,7 @@ fn a_saved_scene_reads_back_as_the_edited_scene() {
     ));
     // The assembled scene puts the bunny where the viewer drew it.
     let (lo, hi) = back.scene.virtual_objects.bvh.bounds().expect("a bunny");
-    let reloaded = ibl_viewer::shadow_atlas::bounding_sphere(lo, hi);
+    let reloaded = ibl_viewer::light_space::bounding_sphere(lo, hi);
     let (drawn, _) = model.objects_sphere().expect("a bunny");
     // The viewer bounds the transformed load-time box; the reload bounds the exact triangles:
     // centres agree to a fraction of the 0.7 m object, measured 0.02 m.
