@@ -30,7 +30,14 @@
 //! multiple importance sampling. The upper half is rows `0..ceil(H / 2)`, the lower half rows
 //! `floor(H / 2)..H` (an odd height's middle row straddles the horizon and belongs to both), so
 //! every direction such a vertex can receive light from stays in the region and the estimate
-//! stays unbiased.
+//! stays unbiased. [`EnvironmentLight::half_irradiance`] gives the irradiance such a surface
+//! receives from its half with nothing in the way, `sum L_ij kappa_ij`, `kappa_ij = (pi / W)
+//! (mu_hi^2 - mu_lo^2)` the texel's cosine-weighted solid angle (`mu = |cos(theta)|` over the
+//! part of the row's band on the half's side of the horizon): the tracer's control variate.
+//!
+//! **Normal bins.** Any other surface draws from its normal's bin ([`crate::normal_bins`]), in
+//! proportion to radiance times a bound of its cosine, so its samples land above it and more of
+//! them where the cosine is large; [`SampleRegion::Facing`].
 //!
 //! Texel look-up uses `theta = atan2(sqrt(x^2 + z^2), y)`, well conditioned at the poles, and
 //! `phi = atan2(x, -z)` in f32 (within about `2.4e-7` rad: a thousandth of a texel up to 8192
@@ -46,6 +53,7 @@ use ibl_core::rgb::Rgb64;
 use ibl_core::{Image, LatLong, Rgb};
 use rayon::prelude::*;
 
+use crate::normal_bins::NormalBins;
 use crate::sampling::{Distribution1D, UniformCone, cos_sin_turn};
 
 /// How far (as a fraction of a texel) sampled texel coordinates stay from the texel's edges.
@@ -123,6 +131,8 @@ pub struct EnvironmentLight {
     importance: bool,
     /// The upper and lower halves' own row distributions ([`SampleRegion`]).
     halves: [HalfRows; 2],
+    /// The distributions of [`SampleRegion::Facing`].
+    normal_bins: NormalBins,
 }
 
 /// The directions an environment sample is drawn from (module notes, "Half-sphere sampling").
@@ -134,6 +144,9 @@ pub enum SampleRegion {
     Upper,
     /// The probe's lower half, rows `floor(H / 2)..H`: for a surface facing the probe's -Y.
     Lower,
+    /// The directions a surface whose normal falls in normal bin `k` can receive light from,
+    /// in proportion to radiance times a bound of the cosine ([`crate::normal_bins`]).
+    Facing(u16),
 }
 
 /// The rows of one half of the map and their own distribution.
@@ -145,6 +158,9 @@ struct HalfRows {
     marginal: Distribution1D,
     /// `1 / P_half`: the whole map's weight over the half's (0 when the half is black).
     density_scale: f32,
+    /// `sum_ij L_ij kappa_ij` over the half (module notes): the irradiance a surface facing its
+    /// pole receives from it, unshadowed (exact for the texel-constant probe).
+    irradiance: Rgb,
 }
 
 /// One texel's radiance and sampling density, read together.
@@ -192,7 +208,7 @@ impl EnvironmentLight {
 
         let latlong = LatLong::new(width, height);
         let row_solid_angle = latlong.row_solid_angles();
-        let row_edge_cos = (0..=height)
+        let row_edge_cos: Vec<f64> = (0..=height)
             .map(|j| (PI * j as f64 / height as f64).cos())
             .collect();
         let radiance: Vec<Rgb> = probe
@@ -209,7 +225,13 @@ impl EnvironmentLight {
             .collect();
         let marginal = Distribution1D::new(conditionals.iter().map(Distribution1D::total));
         let importance = marginal.total() > 0.0;
-        let half = |first_row: usize, end_row: usize| {
+        let weights: Vec<f64> = radiance
+            .iter()
+            .enumerate()
+            .map(|(k, l)| f64::from(l.luminance()) * row_solid_angle[k / width])
+            .collect();
+        let normal_bins = NormalBins::new(width, height, &weights);
+        let half = |first_row: usize, end_row: usize, sign: f64| {
             let half_marginal = Distribution1D::new(
                 conditionals[first_row..end_row]
                     .iter()
@@ -220,13 +242,34 @@ impl EnvironmentLight {
             } else {
                 0.0
             };
+            // `kappa_j = (pi / W) (mu_hi^2 - mu_lo^2)` over the part of row `j`'s band on the
+            // half's side of the horizon.
+            let mut irradiance = Rgb64::ZERO;
+            for j in first_row..end_row {
+                let (a, b) = (sign * row_edge_cos[j], sign * row_edge_cos[j + 1]);
+                let (lo, hi) = (a.min(b).max(0.0), a.max(b).max(0.0));
+                let kappa = PI / width as f64 * (hi * hi - lo * lo);
+                let mut row_sum = Rgb64::ZERO;
+                for &l in &radiance[j * width..(j + 1) * width] {
+                    row_sum.add_weighted(l, kappa);
+                }
+                irradiance = irradiance + row_sum;
+            }
             HalfRows {
                 first_row,
                 marginal: half_marginal,
                 density_scale,
+                irradiance: Rgb::new(
+                    irradiance.r as f32,
+                    irradiance.g as f32,
+                    irradiance.b as f32,
+                ),
             }
         };
-        let halves = [half(0, height.div_ceil(2)), half(height / 2, height)];
+        let halves = [
+            half(0, height.div_ceil(2), 1.0),
+            half(height / 2, height, -1.0),
+        ];
         // `p_ij / dOmega_j` (module notes), or the uniform sphere's density for a black map.
         let texels = radiance
             .par_chunks_exact(width)
@@ -258,6 +301,7 @@ impl EnvironmentLight {
             conditionals,
             importance,
             halves,
+            normal_bins,
         })
     }
 
@@ -311,19 +355,49 @@ impl EnvironmentLight {
     pub fn radiance_and_pdf_in(&self, region: SampleRegion, dir_world: Vec3) -> (Rgb, f32) {
         let (i, j) = self.texel_of(dir_world);
         let texel = self.texels[j * self.latlong.width + i];
-        (texel.radiance, texel.pdf_sr * self.region_scale(region, j))
+        let pdf = match region {
+            SampleRegion::Facing(bin) if self.importance => self.facing_density(bin, i, j),
+            _ => texel.pdf_sr * self.region_scale(region, j),
+        };
+        (texel.radiance, pdf)
     }
 
     /// The region a surface with the world geometric normal `normal` can receive light from:
     /// a half when the normal is exactly the probe's up or down axis (its other two
-    /// components exactly 0), the whole sphere otherwise and for a black map.
+    /// components exactly 0), else its normal bin ([`SampleRegion::Facing`]); the whole sphere
+    /// for a zero or non-finite normal, a bin no light reaches, and a black map.
     pub fn region_for(&self, normal: Vec3) -> SampleRegion {
+        if !self.importance {
+            return SampleRegion::Sphere;
+        }
         let n = self.probe_from_world * normal;
-        match (self.importance && n.x == 0.0 && n.z == 0.0, n.y) {
+        match (n.x == 0.0 && n.z == 0.0, n.y) {
             (true, y) if y > 0.0 => SampleRegion::Upper,
             (true, y) if y < 0.0 => SampleRegion::Lower,
-            _ => SampleRegion::Sphere,
+            _ => self
+                .normal_bins
+                .bin_of(n)
+                .map_or(SampleRegion::Sphere, SampleRegion::Facing),
         }
+    }
+
+    /// The irradiance (scaled radiance x sr) a surface facing `region`'s pole receives from its
+    /// half with nothing in the way, `sum L_ij kappa_ij` (module notes): the expectation of
+    /// `L cos(theta) / pdf` over the samples of any unbiased strategy. `None` for the sphere, a
+    /// normal bin and a black map.
+    pub fn half_irradiance(&self, region: SampleRegion) -> Option<Rgb> {
+        match region {
+            _ if !self.importance => None,
+            SampleRegion::Upper => Some(self.halves[0].irradiance),
+            SampleRegion::Lower => Some(self.halves[1].irradiance),
+            SampleRegion::Sphere | SampleRegion::Facing(_) => None,
+        }
+    }
+
+    /// The density (1/sr) of [`SampleRegion::Facing`]`(bin)` in texel `(i, j)`.
+    #[inline]
+    fn facing_density(&self, bin: u16, i: usize, j: usize) -> f32 {
+        (f64::from(self.normal_bins.texel_probability(bin, i, j)) / self.row_solid_angle[j]) as f32
     }
 
     /// The factor from the whole sphere's density to `region`'s in row `j`.
@@ -332,7 +406,7 @@ impl EnvironmentLight {
         let half = match region {
             // A black map is sampled uniformly over the sphere in every region.
             _ if !self.importance => return 1.0,
-            SampleRegion::Sphere => return 1.0,
+            SampleRegion::Sphere | SampleRegion::Facing(_) => return 1.0,
             SampleRegion::Upper => &self.halves[0],
             SampleRegion::Lower => &self.halves[1],
         };
@@ -351,26 +425,31 @@ impl EnvironmentLight {
         self.sample_in(SampleRegion::Sphere, u1, u2)
     }
 
-    /// [`EnvironmentLight::sample`] within `region` (module notes, "Half-sphere sampling"):
-    /// `u1` picks the row among the region's, `u2` the column. A black half gives density 0
-    /// (no light can come from it).
+    /// [`EnvironmentLight::sample`] within `region` (module notes, "Half-sphere sampling" and
+    /// "Normal bins"): `u1` picks the row among the region's (a bin: the cell, then the band
+    /// within the texel), `u2` the column (a bin: the texel within the cell, then the column
+    /// range). A black half gives density 0 (no light can come from it).
     pub fn sample_in(&self, region: SampleRegion, u1: f32, u2: f32) -> EnvSample {
         let (marginal, first_row) = match region {
-            SampleRegion::Sphere => (&self.marginal, 0),
+            SampleRegion::Sphere | SampleRegion::Facing(_) => (&self.marginal, 0),
             SampleRegion::Upper => (&self.halves[0].marginal, self.halves[0].first_row),
             SampleRegion::Lower => (&self.halves[1].marginal, self.halves[1].first_row),
         };
-        let chosen = if self.importance {
-            marginal.sample(u1).and_then(|mut row| {
-                row.index += first_row;
-                self.conditionals[row.index]
+        // The texel, and where in its band of `cos(theta)` and its range of `phi`.
+        let chosen = match region {
+            _ if !self.importance => None,
+            SampleRegion::Facing(bin) => self
+                .normal_bins
+                .sample(bin, u1, u2)
+                .map(|t| (t.row, t.along_row_band, t.column, t.along_columns)),
+            _ => marginal.sample(u1).and_then(|row| {
+                let j = first_row + row.index;
+                self.conditionals[j]
                     .sample(u2)
-                    .map(|column| (row, column))
-            })
-        } else {
-            None
+                    .map(|column| (j, row.remapped, column.index, column.remapped))
+            }),
         };
-        let Some((row, column)) = chosen else {
+        let Some((j, along_band, i, along_columns)) = chosen else {
             let direction = UniformCone::SPHERE.sample(u1, u2);
             return EnvSample {
                 direction,
@@ -378,24 +457,26 @@ impl EnvironmentLight {
                 pdf_sr: UniformCone::SPHERE.pdf(),
             };
         };
-        let j = row.index;
-        let i = column.index;
         let inset = |f: f32| EDGE_MARGIN + (1.0 - 2.0 * EDGE_MARGIN) * f64::from(f);
         let w = self.latlong.width;
         // `phi = 2 pi (t - 1/2)`, so `(cos phi, sin phi) = -(cos 2 pi t, sin 2 pi t)`, each
         // within 2e-7 ([`cos_sin_turn`]).
-        let t = (i as f64 + inset(column.remapped)) / w as f64;
+        let t = (i as f64 + inset(along_columns)) / w as f64;
         let (cos_turn, sin_turn) = cos_sin_turn(t as f32);
         let (c0, c1) = (self.row_edge_cos[j], self.row_edge_cos[j + 1]);
-        let cos_theta = c0 + inset(row.remapped) * (c1 - c0);
+        let cos_theta = c0 + inset(along_band) * (c1 - c0);
         let sin_theta = ((1.0 - cos_theta) * (1.0 + cos_theta)).max(0.0).sqrt();
         let (sp, cp) = (-f64::from(sin_turn), -f64::from(cos_turn));
         let probe_dir = DVec3::new(sin_theta * sp, cos_theta, -sin_theta * cp).as_vec3();
         let texel = self.texels[j * w + i];
+        let pdf_sr = match region {
+            SampleRegion::Facing(bin) => self.facing_density(bin, i, j),
+            _ => texel.pdf_sr * self.region_scale(region, j),
+        };
         EnvSample {
             direction: (self.world_from_probe * probe_dir).normalize_or(Vec3::Y),
             radiance: texel.radiance,
-            pdf_sr: texel.pdf_sr * self.region_scale(region, j),
+            pdf_sr,
         }
     }
 

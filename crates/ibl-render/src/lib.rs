@@ -19,6 +19,7 @@ pub mod environment;
 pub mod footprint;
 pub mod lighting;
 pub mod material;
+pub mod normal_bins;
 pub mod render;
 pub mod sampler;
 pub mod sampling;

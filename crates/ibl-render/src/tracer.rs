@@ -4,13 +4,16 @@
 //! - **reference**: a unidirectional path tracer (Kajiya 1986) with next-event estimation. At each
 //!   diffuse or glossy vertex one environment sample (importance-sampled by texel power, from the
 //!   probe's upper or lower half alone where the surface faces one of its poles exactly, a floor
-//!   or a ceiling: [`crate::environment::EnvironmentLight::region_for`]) and the
-//!   BSDF sample that continues the path are combined by the power heuristic (Veach 1997, multiple
-//!   importance sampling); an escaping BSDF sample adds the probe's radiance with the
-//!   complementary weight. Mirrors are delta: escaping mirror rays add the probe unweighted. Paths
-//!   stop after `bounces` surface vertices, with Russian roulette from the fourth vertex on
-//!   (survival probability = the throughput's largest channel, at most 0.95). Unbiased: the judge
-//!   of every approximation.
+//!   or a ceiling, else from its normal's bin, radiance times a bound of the cosine:
+//!   [`crate::environment::EnvironmentLight::region_for`]) and the BSDF sample that continues
+//!   the path are combined by the power heuristic (Veach 1997, multiple importance sampling); an
+//!   escaping BSDF sample adds the probe's radiance with the complementary weight. A diffuse
+//!   floor in a scene whose real geometry is one plane takes its exact unshadowed light instead
+//!   and subtracts what the two samples find blocked (`EnvironmentStrategy`, a control
+//!   variate). Mirrors are delta: escaping mirror rays add the probe unweighted. Paths stop after
+//!   `bounces` surface vertices, with Russian roulette from the fourth vertex on (survival
+//!   probability = the throughput's largest channel, at most 0.95). Unbiased: the judge of every
+//!   approximation.
 //! - **lights**: deterministic direct light. At the first diffuse or glossy vertex (after any
 //!   mirror bounces, which are followed exactly) every light is evaluated with its own shadow ray:
 //!   along its direction (hard) or towards a point of its cone drawn from one 2-D sample of the
@@ -58,7 +61,7 @@ use ibl_scene::bvh::OccluderHint;
 use ibl_scene::{Hit, Ray, Scene, ShadowKind, SurfacePoint};
 use rayon::prelude::*;
 
-use crate::environment::SampleRegion;
+use crate::environment::{EnvironmentLight, SampleRegion};
 use crate::lighting::{Ambient, Illumination, LightList, Lighting, RayRole};
 use crate::material::Bsdf;
 use crate::sampler::SampleStream;
@@ -208,6 +211,47 @@ struct Vertex<'a> {
     wo: Vec3,
     /// The BSDF's one value when it is diffuse ([`Bsdf::lambertian`]), read once per vertex.
     lambertian: Option<Rgb>,
+}
+
+/// How one vertex's environment sample and the BSDF sample leaving it share the probe's light
+/// (multiple importance sampling, Veach 1997 section 9.2).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct EnvironmentStrategy {
+    /// Where the environment sample is drawn from.
+    region: SampleRegion,
+    /// A control variate (Glasserman 2004, section 4.1) for a diffuse floor or ceiling (its
+    /// shading normal its geometric one) in a scene whose real geometry is one plane, so that
+    /// only the virtual objects can shadow it: `f E_half`, the vertex's exact unshadowed light
+    /// from the probe ([`EnvironmentLight::half_irradiance`]). The vertex then takes it and
+    /// subtracts what its two MIS-weighted samples find blocked: the environment sample's
+    /// `w_L f L cos / p_L` where its shadow ray is blocked, the BSDF sample's `w_B f L cos /
+    /// p_B` where it meets a surface (its escape adds nothing). Since the weights sum to 1,
+    /// `E[sum_s w_s f L cos / p_s] = f E_half`, so the expectation is the shadowed light; with
+    /// nothing in the way every sample gives the exact value in every channel, where plain MIS
+    /// adds the noise of the texels' colours and of the two densities. In a shadow the
+    /// estimate is as noisy as before and may fall below 0 (a blocked texel of another colour
+    /// than the mean takes off more than its share in one channel), which is why closed
+    /// scenes, mostly in shadow, keep plain MIS.
+    unshadowed: Option<Rgb>,
+}
+
+impl EnvironmentStrategy {
+    /// The strategy at `surface`, seen from a vertex whose BSDF value is `lambertian`
+    /// ([`Bsdf::lambertian`]); `open` when the real geometry is one plane.
+    fn at(
+        env: &EnvironmentLight,
+        surface: &SurfacePoint,
+        lambertian: Option<Rgb>,
+        open: bool,
+    ) -> Self {
+        let region = env.region_for(surface.geometric_normal);
+        let flat = surface.shading_normal == surface.geometric_normal;
+        let unshadowed = match (lambertian, env.half_irradiance(region)) {
+            (Some(f), Some(irradiance)) if flat && open => Some(f * irradiance),
+            _ => None,
+        };
+        EnvironmentStrategy { region, unshadowed }
+    }
 }
 
 /// Light arriving at a vertex, with the objects and (when the walk can tell) without them.
@@ -412,10 +456,13 @@ impl<'a> Tracer<'a> {
         let mut throughput = Rgb::ONE;
         let mut ray = ray;
         let mut primary = PrimaryHit::Background;
-        // Density of the BSDF sample that made `ray` (None: camera ray or mirror), and the
-        // region its vertex's environment sample was drawn from (its MIS partner).
-        let mut bsdf_pdf: Option<(f32, SampleRegion)> = None;
-        let mut region = SampleRegion::Sphere;
+        // Density of the BSDF sample that made `ray` (None: camera ray or mirror), and how its
+        // vertex's environment sample (its MIS partner) was drawn.
+        let mut bsdf_pdf: Option<(f32, EnvironmentStrategy)> = None;
+        let mut strategy = EnvironmentStrategy {
+            region: SampleRegion::Sphere,
+            unshadowed: None,
+        };
         let mut vertex = 0u32;
         let mut without_objects = None;
         let mut new_light = Rgb::ZERO;
@@ -424,6 +471,11 @@ impl<'a> Tracer<'a> {
                 radiance += throughput * self.escaped(ray.direction, bsdf_pdf);
                 break;
             };
+            if let Some((pdf, strategy)) = bsdf_pdf {
+                // A blocked BSDF sample of a control-variate vertex takes its share of the
+                // probe's light back off ([`EnvironmentStrategy::unshadowed`]).
+                radiance = radiance - throughput * self.escape_share(ray.direction, pdf, strategy);
+            }
             state.on_flat_real = self.flat_real_layer && !is_virtual;
             if vertex == 0 {
                 primary = if is_virtual {
@@ -451,15 +503,17 @@ impl<'a> Tracer<'a> {
                 match &self.lighting.illumination {
                     Illumination::Environment => {
                         let vertex = Vertex::new(&surface, &bsdf, wo);
-                        region = self
-                            .lighting
-                            .environment
-                            .region_for(surface.geometric_normal);
+                        strategy = EnvironmentStrategy::at(
+                            &self.lighting.environment,
+                            &surface,
+                            vertex.lambertian,
+                            self.flat_real_layer,
+                        );
                         let none = LayeredLight::none(&state);
                         let luminaires = self.luminaires(&vertex, &mut state, none);
                         new_light += throughput * luminaires.with;
                         radiance += throughput
-                            * (self.environment_sample(&vertex, region, stream, &mut state)
+                            * (self.environment_sample(&vertex, strategy, stream, &mut state)
                                 + luminaires.with);
                     }
                     Illumination::Lights(list) => {
@@ -498,7 +552,7 @@ impl<'a> Tracer<'a> {
                 break;
             };
             throughput = throughput * sample.weight;
-            bsdf_pdf = (!sample.is_delta).then_some((sample.pdf_sr, region));
+            bsdf_pdf = (!sample.is_delta).then_some((sample.pdf_sr, strategy));
             if vertex >= ROULETTE_FROM {
                 let survive = throughput.max_channel().min(0.95);
                 if survive <= 0.0 || stream.next_1d() >= survive {
@@ -524,15 +578,19 @@ impl<'a> Tracer<'a> {
     }
 
     /// Radiance added by a ray that left the scene; `bsdf_pdf` is the density of the BSDF sample
-    /// that made it and the region of its vertex's environment sample (`None` for the camera
+    /// that made it and how its vertex's environment sample was drawn (`None` for the camera
     /// ray or a mirror bounce).
-    fn escaped(&self, direction: Vec3, bsdf_pdf: Option<(f32, SampleRegion)>) -> Rgb {
+    fn escaped(&self, direction: Vec3, bsdf_pdf: Option<(f32, EnvironmentStrategy)>) -> Rgb {
         let env = &self.lighting.environment;
         match (&self.lighting.illumination, bsdf_pdf) {
             // The camera, or a mirror: the probe itself in every mode.
             (_, None) => env.radiance(direction),
-            (Illumination::Environment, Some((pdf, region))) => {
-                let (radiance, env_pdf) = env.radiance_and_pdf_in(region, direction);
+            // Already in the vertex's unshadowed light.
+            (Illumination::Environment, Some((_, strategy))) if strategy.unshadowed.is_some() => {
+                Rgb::ZERO
+            }
+            (Illumination::Environment, Some((pdf, strategy))) => {
+                let (radiance, env_pdf) = env.radiance_and_pdf_in(strategy.region, direction);
                 radiance * power_heuristic(pdf, env_pdf)
             }
             // The lights (and the ambient) stand for the probe; their paths end at the first
@@ -541,20 +599,49 @@ impl<'a> Tracer<'a> {
         }
     }
 
-    /// One environment sample from `region` (the half a floor or ceiling can see, else the
-    /// sphere: [`crate::environment::EnvironmentLight::region_for`]), MIS-weighted against
-    /// BSDF sampling.
+    /// The probe's light, MIS-weighted, that a BSDF sample of density `pdf` leaving a
+    /// control-variate vertex would have brought along `direction` had it escaped
+    /// ([`EnvironmentStrategy::unshadowed`]); 0 for any other vertex.
+    fn escape_share(&self, direction: Vec3, pdf: f32, strategy: EnvironmentStrategy) -> Rgb {
+        if strategy.unshadowed.is_none() {
+            return Rgb::ZERO;
+        }
+        let (radiance, env_pdf) = self
+            .lighting
+            .environment
+            .radiance_and_pdf_in(strategy.region, direction);
+        radiance * power_heuristic(pdf, env_pdf)
+    }
+
+    /// One environment sample from the strategy's region (the half a floor or ceiling can see,
+    /// cosine-weighted, else the sphere: [`crate::environment::EnvironmentLight::region_for`]),
+    /// MIS-weighted against BSDF sampling ([`EnvironmentStrategy`]).
     fn environment_sample(
         &self,
         vertex: &Vertex,
-        region: SampleRegion,
+        strategy: EnvironmentStrategy,
         stream: &mut SampleStream,
         state: &mut PathState,
     ) -> Rgb {
         let env = &self.lighting.environment;
         let [u1, u2] = stream.next_2d();
-        let sample = env.sample_in(region, u1, u2);
+        let sample = env.sample_in(strategy.region, u1, u2);
         let wi = sample.direction;
+        if let Some(unshadowed) = strategy.unshadowed {
+            // The control variate ([`EnvironmentStrategy::unshadowed`]): a sample that could not
+            // light the vertex (zero density, below the surface) has nothing to take off.
+            let blocked = match vertex.reflection(wi) {
+                Some(f_cos)
+                    if sample.pdf_sr > 0.0
+                        && self.occlusion(above(vertex.surface), wi, state) != Occlusion::Open =>
+                {
+                    let weight = power_heuristic(sample.pdf_sr, vertex.bsdf.pdf(vertex.wo, wi));
+                    f_cos * sample.radiance * (weight / sample.pdf_sr)
+                }
+                _ => Rgb::ZERO,
+            };
+            return unshadowed - blocked;
+        }
         if sample.pdf_sr <= 0.0 {
             return Rgb::ZERO;
         }

@@ -361,13 +361,23 @@ fn environment_samples_follow_their_density() {
 }
 
 #[test]
-fn half_sphere_samples_follow_their_density() {
-    // The floor's and the ceiling's regions under a probe turned about its up axis, on the same
-    // tilted cells as above (their expected shares integrated the same way; the cells the horizon
-    // crosses are exact there too, the density being 0 below it, so only texel edges err).
+fn half_sphere_and_normal_bin_samples_follow_their_density() {
+    // The floor's and the ceiling's regions under a probe turned about its up axis, and two
+    // normal bins' (`normal_bins`), on the same tilted cells as above (their expected shares
+    // integrated the same way; the cells the horizon crosses are exact there too, the density
+    // being 0 below it, and a bin's density is constant per texel, so only texel edges err).
     let env = EnvironmentLight::new(random_map(), Mat3::from_rotation_y(0.7), 1.0).unwrap();
     let grid = SphereGrid::new(Vec3::new(0.3, 0.9, -0.2).normalize(), 30, 60);
-    for (region, seed) in [(SampleRegion::Upper, 25), (SampleRegion::Lower, 26)] {
+    let bins = [
+        env.region_for(Vec3::new(0.3, 0.9, -0.2).normalize()),
+        env.region_for(Vec3::new(-0.6, 0.1, 0.8).normalize()),
+    ];
+    for (region, seed) in [
+        (SampleRegion::Upper, 25),
+        (SampleRegion::Lower, 26),
+        (bins[0], 27),
+        (bins[1], 28),
+    ] {
         let n = 1_000_000;
         let mut rng = PixelRng::new(seed, 0, 0);
         let mut counts = vec![0.0; grid.cells()];

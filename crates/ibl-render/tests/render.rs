@@ -403,10 +403,10 @@ fn a_floor_reflects_its_exact_irradiance_from_the_upper_half() {
     // nothing else, so it reflects `albedo E / pi` everywhere, `E` the sum over the upper rows'
     // texels of `L dphi (sin^2 theta_1 - sin^2 theta_0) / 2` (a texel's cosine-weighted solid
     // angle). Its environment samples come from the upper half alone
-    // (`EnvironmentLight::region_for`); a wrong density there (the half's weight, or its
-    // multiple-importance weight against the BSDF's) would move every pixel by the same factor.
-    // The pixels' estimates are independent, so their mean has standard error sd / sqrt(n):
-    // |z| < 4, as in the furnace test.
+    // (`EnvironmentLight::region_for`), and with nothing in the way each one gives the exact
+    // value (the tracer's control variate, `EnvironmentStrategy`), so every pixel must equal it
+    // to f32 rounding (1e-5 relative: the half's irradiance summed in f64 and rounded once, the
+    // samples' mean in f32). Its statistics: the next test.
     let probe = sky_probe();
     let toml = format!(
         "version = 1\n[probe]\nfile = \"sky.exr\"\n\
@@ -443,12 +443,66 @@ fn a_floor_reflects_its_exact_irradiance_from_the_upper_half() {
             .iter()
             .map(|p| f64::from(p[k]))
             .collect();
-        let (mean, sd) = mean_and_sd(&values);
         let expected = albedo[k] * irradiance[k] / PI;
-        let z = (mean - expected) / (sd / (values.len() as f64).sqrt());
+        for (p, &value) in values.iter().enumerate() {
+            assert!(
+                (value - expected).abs() <= 1e-5 * expected,
+                "channel {k}, pixel {p}: {value} expected {expected}"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_floors_control_variate_agrees_with_plain_sampling_in_the_shadows() {
+    // The floor's control variate (`EnvironmentStrategy`: the exact unshadowed light, less what
+    // its shadow rays find blocked) against plain multiple importance sampling of the same
+    // floor: tilting the probe by 0.01 degrees about +X takes the floor off the probe's pole,
+    // so it samples its normal bin and weighs its BSDF samples by MIS. The tilt moves the
+    // sun's texel by 1.7e-4 rad, about 1e-4 of the light: far below the test's resolution.
+    // The sphere's shadows (the sun's, and the sky's occlusion) are where the variate
+    // subtracts. Per ground pixel the two independent estimates' difference has mean 0; its
+    // mean over the ground has standard error sd / sqrt(n): |z| < 4.
+    let render_with = |pitch: f64, seed: u64| {
+        let view = SKY_VIEW.replace(
+            "file = \"sky.exr\"",
+            &format!("file = \"sky.exr\"\nrotation_deg = [0.0, {pitch}, 0.0]"),
+        );
+        let toml = format!(
+            r#"{view}
+{GROUND}
+[[object]]
+shape = "sphere"
+center = [0.0, -0.5, 0.0]
+radius = 0.5
+material = {{ kind = "diffuse", albedo = [0.7, 0.7, 0.7] }}
+"#
+        );
+        let scene = scene(&toml, sky_probe());
+        let lighting = Lighting::reference(&scene).unwrap();
+        run(
+            &scene,
+            &lighting,
+            &settings(64, 3, seed, CompositeRule::Difference),
+        )
+    };
+    let variate = render_with(0.0, 5);
+    let plain = render_with(0.01, 6);
+    for k in 0..3 {
+        let differences: Vec<f64> = variate
+            .with_objects
+            .pixels()
+            .iter()
+            .zip(plain.with_objects.pixels())
+            .zip(variate.object_coverage.pixels())
+            .filter(|&(_, &coverage)| coverage == 0.0)
+            .map(|((a, b), _)| f64::from(a[k]) - f64::from(b[k]))
+            .collect();
+        let (mean, sd) = mean_and_sd(&differences);
+        let z = mean / (sd / (differences.len() as f64).sqrt());
         assert!(
             z.abs() < 4.0,
-            "channel {k}: mean {mean} expected {expected} (z = {z})"
+            "channel {k}: mean difference {mean} (z = {z})"
         );
     }
 }

@@ -253,15 +253,18 @@ fn environment_pdf_integrates_to_one_over_the_sphere() {
     ] {
         let env = EnvironmentLight::new(map, rotation, 1.0).unwrap();
         let cell = 4.0 * PI / (NZ * NPHI) as f64;
-        // The sphere's density and each half's (module notes of `environment`).
+        // The sphere's density, each half's (module notes of `environment`) and two normal
+        // bins' (`normal_bins`; a black map has none: the sphere stands in).
         let regions = [
             SampleRegion::Sphere,
             SampleRegion::Upper,
             SampleRegion::Lower,
+            env.region_for(Vec3::new(0.3, 0.9, -0.2).normalize()),
+            env.region_for(Vec3::new(-0.8, -0.1, 0.6).normalize()),
         ];
-        let mut totals = [0.0_f64; 3];
+        let mut totals = [0.0_f64; 5];
         for iz in 0..NZ {
-            let mut rows = [0.0_f64; 3];
+            let mut rows = [0.0_f64; 5];
             for ip in 0..NPHI {
                 let z = 1.0 - 2.0 * (iz as f64 + f64::from(rng.next_f32())) / NZ as f64;
                 let r = (1.0 - z * z).max(0.0).sqrt();
@@ -348,6 +351,50 @@ fn half_sphere_regions_sample_their_half_with_their_density() {
 }
 
 #[test]
+fn normal_bins_sample_with_their_density_wherever_their_normals_receive_light() {
+    // Every direction a surface with normal `n` can receive light from (`n . w > 0`, the texel
+    // not black) has a positive density in `n`'s bin (the cosine bound of `normal_bins`), and a
+    // sample's density is the one `radiance_and_pdf_in` reads back. Random normals, not aligned
+    // with the probe, on a turned probe; an odd height and width.
+    let env = EnvironmentLight::new(random_map(45, 23), rotation(), 2.0).unwrap();
+    let mut rng = PixelRng::new(17, 0, 0);
+    let unit = |rng: &mut PixelRng| loop {
+        let v = Vec3::new(
+            2.0 * rng.next_f32() - 1.0,
+            2.0 * rng.next_f32() - 1.0,
+            2.0 * rng.next_f32() - 1.0,
+        );
+        if (0.01..1.0).contains(&v.length_squared()) {
+            return v.normalize();
+        }
+    };
+    let mut above = 0usize;
+    for _ in 0..500 {
+        let normal = unit(&mut rng);
+        let region = env.region_for(normal);
+        assert!(matches!(region, SampleRegion::Facing(_)), "{normal}");
+        for _ in 0..200 {
+            let w = unit(&mut rng);
+            if normal.dot(w) > 1e-4 && env.radiance(w).max_channel() > 0.0 {
+                above += 1;
+                assert!(env.radiance_and_pdf_in(region, w).1 > 0.0, "{normal} {w}");
+            }
+            let s = env.sample_in(region, rng.next_f32(), rng.next_f32());
+            assert!(s.pdf_sr > 0.0 && s.radiance.max_channel() > 0.0);
+            assert!((s.direction.length() - 1.0).abs() < 1e-5);
+            let (radiance, pdf) = env.radiance_and_pdf_in(region, s.direction);
+            assert_eq!(radiance, s.radiance);
+            assert!(
+                (pdf - s.pdf_sr).abs() <= 1e-6 * s.pdf_sr,
+                "pdf {pdf} vs sampled {}",
+                s.pdf_sr
+            );
+        }
+    }
+    assert!(above > 30_000, "{above}");
+}
+
+#[test]
 fn only_a_surface_facing_the_probes_poles_exactly_samples_a_half() {
     let env = EnvironmentLight::new(random_map(64, 32), Mat3::from_rotation_y(2.0), 1.0).unwrap();
     assert_eq!(env.region_for(Vec3::Y), SampleRegion::Upper);
@@ -356,14 +403,17 @@ fn only_a_surface_facing_the_probes_poles_exactly_samples_a_half() {
         SampleRegion::Upper
     );
     assert_eq!(env.region_for(Vec3::NEG_Y), SampleRegion::Lower);
-    // A tilted surface, or a tilted probe: the sphere.
+    // A tilted surface, or a tilted probe: its normal's bin; no normal: the sphere.
     let tilted = Vec3::new(1e-3, 1.0, 0.0).normalize();
-    assert_eq!(env.region_for(tilted), SampleRegion::Sphere);
-    assert_eq!(env.region_for(Vec3::X), SampleRegion::Sphere);
+    assert!(matches!(env.region_for(tilted), SampleRegion::Facing(_)));
+    assert!(matches!(env.region_for(Vec3::X), SampleRegion::Facing(_)));
     assert_eq!(env.region_for(Vec3::ZERO), SampleRegion::Sphere);
     assert_eq!(env.region_for(Vec3::splat(f32::NAN)), SampleRegion::Sphere);
     let tilted_probe = EnvironmentLight::new(random_map(64, 32), rotation(), 1.0).unwrap();
-    assert_eq!(tilted_probe.region_for(Vec3::Y), SampleRegion::Sphere);
+    assert!(matches!(
+        tilted_probe.region_for(Vec3::Y),
+        SampleRegion::Facing(_)
+    ));
     // A black map is sampled uniformly over the sphere in every region.
     let black =
         EnvironmentLight::new(Image::filled(16, 8, Rgb::ZERO), Mat3::IDENTITY, 1.0).unwrap();

@@ -471,8 +471,8 @@ fn a_probe_too_noisy_for_its_texture_keeps_the_flat_fill() {
         position: PROBE,
         world_from_probe: Mat3::IDENTITY,
     };
-    // 8 samples per pixel: the probe's noise outweighs the tiles' contrast in the texels.
-    let probe = mean(&render_halves(&room, Floor::Checker, panorama, 512, 8));
+    // 4 samples per pixel: the probe's noise outweighs the tiles' contrast in the texels.
+    let probe = mean(&render_halves(&room, Floor::Checker, panorama, 512, 4));
     let analysis =
         analyse_room(&room, &probe, &AnalysisSettings::default(), &|_, _, _| ()).expect("analysis");
     let texture = FillTexture::new(
@@ -486,7 +486,7 @@ fn a_probe_too_noisy_for_its_texture_keeps_the_flat_fill() {
     println!("{:#?}", texture.analysis);
     // Noise of variance n^2 lowers the correlation at the period to s^2 / (s^2 + n^2): under
     // 1/2, where a copy would err more than the flat fill (fill_texture's module doc), so no face
-    // is modulated (measured: no period on the floor; 0.69 at 24 samples).
+    // is modulated (measured: no period on the floor; 0.52 at 8 samples, 0.69 at 24).
     assert!(texture.analysis.iter().all(|a| !a.modulated));
 }
 
