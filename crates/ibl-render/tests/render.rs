@@ -464,21 +464,7 @@ fn a_floors_control_variate_agrees_with_plain_sampling_in_the_shadows() {
     // subtracts. Per ground pixel the two independent estimates' difference has mean 0; its
     // mean over the ground has standard error sd / sqrt(n): |z| < 4.
     let render_with = |pitch: f64, seed: u64| {
-        let view = SKY_VIEW.replace(
-            "file = \"sky.exr\"",
-            &format!("file = \"sky.exr\"\nrotation_deg = [0.0, {pitch}, 0.0]"),
-        );
-        let toml = format!(
-            r#"{view}
-{GROUND}
-[[object]]
-shape = "sphere"
-center = [0.0, -0.5, 0.0]
-radius = 0.5
-material = {{ kind = "diffuse", albedo = [0.7, 0.7, 0.7] }}
-"#
-        );
-        let scene = scene(&toml, sky_probe());
+        let scene = sky_scene_pitched(pitch);
         let lighting = Lighting::reference(&scene).unwrap();
         run(
             &scene,
@@ -855,8 +841,17 @@ image_size_px = [64, 48]
 
 /// The sky probe over a ground plane with a diffuse sphere, seen from above and in front.
 fn sky_scene() -> Scene {
+    sky_scene_pitched(0.0)
+}
+
+/// [`sky_scene`] with the probe pitched by `pitch_deg` (about +X).
+fn sky_scene_pitched(pitch_deg: f64) -> Scene {
+    let view = SKY_VIEW.replace(
+        "file = \"sky.exr\"",
+        &format!("file = \"sky.exr\"\nrotation_deg = [0.0, {pitch_deg}, 0.0]"),
+    );
     let toml = format!(
-        r#"{SKY_VIEW}
+        r#"{view}
 {GROUND}
 [[object]]
 shape = "sphere"

@@ -9,7 +9,7 @@ use std::f64::consts::PI;
 
 use glam::{Mat3, Vec3};
 use ibl_core::{Image, LatLong, Rgb};
-use ibl_render::environment::{EnvironmentLight, SampleRegion};
+use ibl_render::environment::{EnvSample, EnvironmentLight, SampleRegion};
 use ibl_render::material::Bsdf;
 use ibl_render::sampling::{
     OrthonormalBasis, PixelRng, UniformCone, cosine_hemisphere_pdf, power_heuristic,
@@ -306,6 +306,18 @@ fn environment_samples_agree_with_pdf_and_radiance() {
     }
 }
 
+/// A sample's radiance and density are what `radiance_and_pdf_in` reads back for its direction
+/// (density within 1e-6 relative: the same tables, f32 directions).
+fn assert_reads_back(env: &EnvironmentLight, region: SampleRegion, s: &EnvSample) {
+    let (radiance, pdf) = env.radiance_and_pdf_in(region, s.direction);
+    assert_eq!(radiance, s.radiance);
+    assert!(
+        (pdf - s.pdf_sr).abs() <= 1e-6 * s.pdf_sr,
+        "{region:?}: pdf {pdf} vs sampled {}",
+        s.pdf_sr
+    );
+}
+
 #[test]
 fn half_sphere_regions_sample_their_half_with_their_density() {
     // A floor (+Y) and a ceiling (-Y) under a probe turned about its up axis, on an even and an
@@ -333,13 +345,7 @@ fn half_sphere_regions_sample_their_half_with_their_density() {
                     s.direction
                 );
                 assert!(s.pdf_sr > 0.0);
-                let (radiance, pdf) = env.radiance_and_pdf_in(region, s.direction);
-                assert_eq!(radiance, s.radiance);
-                assert!(
-                    (pdf - s.pdf_sr).abs() <= 1e-6 * s.pdf_sr,
-                    "pdf {pdf} vs sampled {}",
-                    s.pdf_sr
-                );
+                assert_reads_back(&env, region, &s);
                 // The half holds at most the whole map's weight: its density is at least the
                 // sphere's.
                 assert!(s.pdf_sr >= env.pdf(s.direction) * (1.0 - 1e-6));
@@ -382,13 +388,7 @@ fn normal_bins_sample_with_their_density_wherever_their_normals_receive_light() 
             let s = env.sample_in(region, rng.next_f32(), rng.next_f32());
             assert!(s.pdf_sr > 0.0 && s.radiance.max_channel() > 0.0);
             assert!((s.direction.length() - 1.0).abs() < 1e-5);
-            let (radiance, pdf) = env.radiance_and_pdf_in(region, s.direction);
-            assert_eq!(radiance, s.radiance);
-            assert!(
-                (pdf - s.pdf_sr).abs() <= 1e-6 * s.pdf_sr,
-                "pdf {pdf} vs sampled {}",
-                s.pdf_sr
-            );
+            assert_reads_back(&env, region, &s);
         }
     }
     assert!(above > 30_000, "{above}");
