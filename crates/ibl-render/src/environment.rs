@@ -216,20 +216,21 @@ impl EnvironmentLight {
             .into_iter()
             .map(|l| l * radiance_scale)
             .collect();
-        let conditionals: Vec<Distribution1D> = radiance
+        // Each texel's sampling weight, `lum(L) dOmega`: the rows' conditionals and the normal
+        // bins share it.
+        let weights: Vec<f64> = radiance
             .par_chunks_exact(width)
             .zip(row_solid_angle.par_iter())
-            .map(|(row, &d_omega)| {
-                Distribution1D::new(row.iter().map(|l| f64::from(l.luminance()) * d_omega))
+            .flat_map_iter(|(row, &d_omega)| {
+                row.iter().map(move |l| f64::from(l.luminance()) * d_omega)
             })
+            .collect();
+        let conditionals: Vec<Distribution1D> = weights
+            .par_chunks_exact(width)
+            .map(|row| Distribution1D::new(row.iter().copied()))
             .collect();
         let marginal = Distribution1D::new(conditionals.iter().map(Distribution1D::total));
         let importance = marginal.total() > 0.0;
-        let weights: Vec<f64> = radiance
-            .iter()
-            .enumerate()
-            .map(|(k, l)| f64::from(l.luminance()) * row_solid_angle[k / width])
-            .collect();
         let normal_bins = NormalBins::new(width, height, &weights);
         let half = |first_row: usize, end_row: usize, sign: f64| {
             let half_marginal = Distribution1D::new(

@@ -68,13 +68,12 @@ pub struct BinnedTexel {
 /// Per-bin cell distributions and per-cell texel distributions of one probe (module notes).
 #[derive(Clone, Debug)]
 pub struct NormalBins {
-    width: usize,
-    height: usize,
     /// Cell boundaries: cell column `x` spans texel columns `column_start[x]..column_start[x+1]`.
     column_start: Vec<usize>,
     /// Cell boundaries down the rows, likewise.
     row_start: Vec<usize>,
-    /// Per texel column, its cell column; per texel row, its cell row.
+    /// Per texel column, its cell column; per texel row, its cell row (their lengths are the
+    /// probe's width and height).
     cell_column: Vec<u16>,
     cell_row: Vec<u16>,
     /// Per cell (row-major), the distribution over its texels (row-major within the cell).
@@ -213,8 +212,6 @@ impl NormalBins {
             })
             .collect();
         NormalBins {
-            width,
-            height,
             column_start,
             row_start,
             cell_column,
@@ -264,13 +261,10 @@ impl NormalBins {
         let Some(Some(bin)) = self.bins.get(usize::from(bin)) else {
             return 0.0;
         };
-        if column >= self.width || row >= self.height {
+        let (Some(&x), Some(&y)) = (self.cell_column.get(column), self.cell_row.get(row)) else {
             return 0.0;
-        }
-        let (x, y) = (
-            usize::from(self.cell_column[column]),
-            usize::from(self.cell_row[row]),
-        );
+        };
+        let (x, y) = (usize::from(x), usize::from(y));
         let cw = self.column_start.len() - 1;
         let cell = y * cw + x;
         let span = self.column_start[x + 1] - self.column_start[x];
@@ -282,6 +276,7 @@ impl NormalBins {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sampling::PixelRng;
 
     #[test]
     fn octahedral_map_round_trips() {
@@ -302,13 +297,8 @@ mod tests {
         // bound itself: `tests/sampling.rs`, a positive density wherever light can arrive).
         let (w, h) = (48, 24);
         let bins = NormalBins::new(w, h, &vec![1.0; w * h]);
-        let mut state = 0x2545_f491_4f6c_dd1d_u64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = PixelRng::new(29, 0, 0);
+        let mut next = || f64::from(rng.next_f32());
         let b = BINS_PER_SIDE as f64;
         for _ in 0..20_000 {
             let k = (next() * (BINS_PER_SIDE * BINS_PER_SIDE) as f64) as usize;

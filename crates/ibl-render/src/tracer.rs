@@ -471,10 +471,13 @@ impl<'a> Tracer<'a> {
                 radiance += throughput * self.escaped(ray.direction, bsdf_pdf);
                 break;
             };
-            if let Some((pdf, strategy)) = bsdf_pdf {
+            if let Some((pdf, strategy)) = bsdf_pdf
+                && strategy.unshadowed.is_some()
+            {
                 // A blocked BSDF sample of a control-variate vertex takes its share of the
                 // probe's light back off ([`EnvironmentStrategy::unshadowed`]).
-                radiance = radiance - throughput * self.escape_share(ray.direction, pdf, strategy);
+                radiance =
+                    radiance - throughput * self.bsdf_share(ray.direction, pdf, strategy.region);
             }
             state.on_flat_real = self.flat_real_layer && !is_virtual;
             if vertex == 0 {
@@ -590,8 +593,7 @@ impl<'a> Tracer<'a> {
                 Rgb::ZERO
             }
             (Illumination::Environment, Some((pdf, strategy))) => {
-                let (radiance, env_pdf) = env.radiance_and_pdf_in(strategy.region, direction);
-                radiance * power_heuristic(pdf, env_pdf)
+                self.bsdf_share(direction, pdf, strategy.region)
             }
             // The lights (and the ambient) stand for the probe; their paths end at the first
             // diffuse or glossy vertex, so this arm is only reached by a BSDF sample there.
@@ -599,22 +601,20 @@ impl<'a> Tracer<'a> {
         }
     }
 
-    /// The probe's light, MIS-weighted, that a BSDF sample of density `pdf` leaving a
-    /// control-variate vertex would have brought along `direction` had it escaped
-    /// ([`EnvironmentStrategy::unshadowed`]); 0 for any other vertex.
-    fn escape_share(&self, direction: Vec3, pdf: f32, strategy: EnvironmentStrategy) -> Rgb {
-        if strategy.unshadowed.is_none() {
-            return Rgb::ZERO;
-        }
+    /// The probe's light along `direction`, MIS-weighted for a BSDF sample of density `pdf`
+    /// whose vertex drew its environment sample from `region`: what the sample adds when it
+    /// escapes, or, at a control-variate vertex ([`EnvironmentStrategy::unshadowed`]), what it
+    /// takes off when it meets a surface.
+    fn bsdf_share(&self, direction: Vec3, pdf: f32, region: SampleRegion) -> Rgb {
         let (radiance, env_pdf) = self
             .lighting
             .environment
-            .radiance_and_pdf_in(strategy.region, direction);
+            .radiance_and_pdf_in(region, direction);
         radiance * power_heuristic(pdf, env_pdf)
     }
 
     /// One environment sample from the strategy's region (the half a floor or ceiling can see,
-    /// cosine-weighted, else the sphere: [`crate::environment::EnvironmentLight::region_for`]),
+    /// else the normal's bin: [`crate::environment::EnvironmentLight::region_for`]),
     /// MIS-weighted against BSDF sampling ([`EnvironmentStrategy`]).
     fn environment_sample(
         &self,
@@ -627,32 +627,26 @@ impl<'a> Tracer<'a> {
         let [u1, u2] = stream.next_2d();
         let sample = env.sample_in(strategy.region, u1, u2);
         let wi = sample.direction;
-        if let Some(unshadowed) = strategy.unshadowed {
-            // The control variate ([`EnvironmentStrategy::unshadowed`]): a sample that could not
-            // light the vertex (zero density, below the surface) has nothing to take off.
-            let blocked = match vertex.reflection(wi) {
-                Some(f_cos)
-                    if sample.pdf_sr > 0.0
-                        && self.occlusion(above(vertex.surface), wi, state) != Occlusion::Open =>
-                {
-                    let weight = power_heuristic(sample.pdf_sr, vertex.bsdf.pdf(vertex.wo, wi));
-                    f_cos * sample.radiance * (weight / sample.pdf_sr)
-                }
-                _ => Rgb::ZERO,
-            };
-            return unshadowed - blocked;
-        }
-        if sample.pdf_sr <= 0.0 {
-            return Rgb::ZERO;
-        }
-        let Some(f_cos) = vertex.reflection(wi) else {
-            return Rgb::ZERO;
+        let reflection = (sample.pdf_sr > 0.0)
+            .then(|| vertex.reflection(wi))
+            .flatten();
+        // Plain MIS adds the sample's light where its shadow ray is open; the control variate
+        // ([`EnvironmentStrategy::unshadowed`]) takes it off where the ray is blocked. A sample
+        // that could not light the vertex (zero density, below the surface) does neither.
+        let light = match reflection {
+            Some(f_cos)
+                if (self.occlusion(above(vertex.surface), wi, state) == Occlusion::Open)
+                    != strategy.unshadowed.is_some() =>
+            {
+                let weight = power_heuristic(sample.pdf_sr, vertex.bsdf.pdf(vertex.wo, wi));
+                f_cos * sample.radiance * (weight / sample.pdf_sr)
+            }
+            _ => Rgb::ZERO,
         };
-        if self.occlusion(above(vertex.surface), wi, state) != Occlusion::Open {
-            return Rgb::ZERO;
+        match strategy.unshadowed {
+            Some(unshadowed) => unshadowed - light,
+            None => light,
         }
-        let weight = power_heuristic(sample.pdf_sr, vertex.bsdf.pdf(vertex.wo, wi));
-        f_cos * sample.radiance * (weight / sample.pdf_sr)
     }
 
     /// Every light, each with its own shadow ray (all from one origin above the surface: a
