@@ -233,9 +233,7 @@ fn run_merge(args: &MergeArgs) -> anyhow::Result<()> {
         deghost: args.deghost,
     };
     let summary = merge_bracket(&job)?;
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(&summary)?);
-    } else {
+    if !super::print_json(args.json, &summary)? {
         println!(
             "merged {} exposures ({} x {}, times from {}): {:.1} stops, {} saturated and {} black \
              pixels; wrote {}",

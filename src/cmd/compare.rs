@@ -71,9 +71,7 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
         pixels_per_degree: args.ppd,
     };
     let summary = compare(&options, &Bars::default())?;
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(&summary)?);
-    } else {
+    if !super::print_json(args.json, &summary)? {
         print_text(&summary);
     }
     if let Some(e) = &summary.error_image {

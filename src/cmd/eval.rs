@@ -75,8 +75,7 @@ pub fn run(args: &EvalArgs) -> anyhow::Result<()> {
     settings.mapping = args.probe_mapping.mapping()?;
     settings.fit_domain = args.fit_domain.domain();
     let report = evaluate(&args.probes, &settings, &args.out, &Bars::default())?;
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
+    if super::print_json(args.json, &report)? {
         return Ok(());
     }
     print!("{}", ibl_pipeline::demo_text::lights_needed_text(&report));

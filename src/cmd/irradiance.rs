@@ -86,9 +86,7 @@ pub fn run(args: &IrradianceArgs) -> anyhow::Result<()> {
         width: args.width,
     };
     let summary = irradiance(&options, &Bars::default())?;
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(&summary)?);
-    } else {
+    if !super::print_json(args.json, &summary)? {
         let what = match summary.window {
             Some(window) => format!("sh irradiance ({} bands, window {window})", args.bands),
             None => format!("{} irradiance", options.method.name()),

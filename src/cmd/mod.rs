@@ -16,3 +16,11 @@ pub mod render;
 pub mod room;
 pub mod sh;
 pub mod view;
+
+/// Prints `summary` as pretty JSON on stdout when `json` is set (`--json`); whether it did.
+pub fn print_json(json: bool, summary: &impl serde::Serialize) -> anyhow::Result<bool> {
+    if json {
+        println!("{}", serde_json::to_string_pretty(summary)?);
+    }
+    Ok(json)
+}

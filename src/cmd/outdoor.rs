@@ -64,8 +64,7 @@ pub fn run(args: &OutdoorArgs) -> anyhow::Result<()> {
     job.video = args.video.clone();
     job.video_fps = args.video_fps;
     let summary = run_outdoor(&job, &Bars::default())?;
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(&summary)?);
+    if super::print_json(args.json, &summary)? {
         return Ok(());
     }
     println!("time                 sky       P_d (sun) R G B            P_a (sky) R G B");

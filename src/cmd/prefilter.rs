@@ -135,8 +135,7 @@ pub fn run(args: &PrefilterArgs) -> anyhow::Result<()> {
         preview: args.preview.clone(),
     };
     let summary = prefilter(&job, &Bars::default())?;
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(&summary)?);
+    if super::print_json(args.json, &summary)? {
         return Ok(());
     }
     if !summary.roughness.is_empty() {

@@ -54,6 +54,7 @@ Examples:
   ibl render scene.toml -o h.exr --mode hybrid --spp 64 --ambient-bands 9 --ao-rays 8
   ibl render scene.toml -o b.exr --width 640 --spp 256 --layers              + with/without/alpha
   ibl render scene.toml -o b.exr --sampler independent                       no low discrepancy
+  ibl render scene.toml -o b.exr --spp 64 --adaptive-sampling      64 spp on average, where noisy
 
 Writes OUT (EXR, or any format ibl writes) and OUT's .png preview, tone-mapped with the exposure
 of the background; --layers adds OUT-with, OUT-without (local scene with and without the objects)
@@ -98,6 +99,10 @@ pub struct RenderArgs {
     /// `[lighting] adaptive`, on: one sample first, the rest only where neighbours differ).
     #[arg(long)]
     pub no_adaptive: bool,
+    /// Reference: --spp paths per pixel on average, more where a pilot pass finds noise, without
+    /// bias (default: the scene's `[render] adaptive_sampling`, off).
+    #[arg(long)]
+    pub adaptive_sampling: bool,
     /// Output width in pixels (panorama: height = width / 2; photo: its aspect ratio).
     #[arg(long, value_name = "W")]
     pub width: Option<u32>,
@@ -143,6 +148,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         ambient_bands: args.ambient_bands,
         occlusion_rays: args.ao_rays,
         no_adaptive: args.no_adaptive,
+        adaptive_sampling: args.adaptive_sampling,
         width: args.width,
         bounces: args.bounces,
         seed: args.seed,
@@ -158,9 +164,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         },
     };
     let summary = render_scene(&job, &Bars::default())?;
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(&summary)?);
-    } else {
+    if !super::print_json(args.json, &summary)? {
         println!("{summary}");
     }
     Ok(())

@@ -9,12 +9,10 @@ use crate::progress::Bars;
 
 /// Runs `ibl view` and prints the headless summary (text, or JSON with `--json`).
 pub fn run(args: &ViewArgs) -> anyhow::Result<()> {
-    if let Some(summary) = ibl_viewer::command_line::run(args, &Bars::default())? {
-        if args.json {
-            println!("{}", serde_json::to_string_pretty(&summary)?);
-        } else {
-            println!("{}", summary.line());
-        }
+    if let Some(summary) = ibl_viewer::command_line::run(args, &Bars::default())?
+        && !super::print_json(args.json, &summary)?
+    {
+        println!("{}", summary.line());
     }
     Ok(())
 }

@@ -169,6 +169,7 @@ fn settings(s: &RenderStudySettings, spp: u32, seed: u64, adaptive: Option<f32>)
         seed,
         sampler: s.sampler,
         adaptive,
+        adaptive_sampling: false,
     }
 }
 

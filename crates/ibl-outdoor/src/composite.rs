@@ -184,6 +184,7 @@ impl FrameCompositor {
             seed: self.settings.seed,
             sampler: SamplerKind::Sobol,
             adaptive: None,
+            adaptive_sampling: false,
         };
         Ok(render(
             &scene,

@@ -251,6 +251,7 @@ impl SyntheticDay {
             // them, and their error is an unbiased standard error per pixel.
             sampler: SamplerKind::Independent,
             adaptive: None,
+            adaptive_sampling: false,
         }
     }
 

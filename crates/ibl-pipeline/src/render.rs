@@ -71,6 +71,9 @@ pub struct RenderJob {
     /// Every pixel takes all its samples in the lights and hybrid modes (`false`: the scene's
     /// `[lighting] adaptive`, on by default).
     pub no_adaptive: bool,
+    /// Adaptive sampling of the reference mode (`false`: the scene's `[render]
+    /// adaptive_sampling`, off by default).
+    pub adaptive_sampling: bool,
     /// Output width in pixels.
     pub width: Option<u32>,
     /// Surface vertices per path.
@@ -126,7 +129,9 @@ pub struct RenderSummary {
     pub spp: u32,
     /// Adaptive antialiasing's contrast threshold (lights and hybrid modes; `None`: off).
     pub adaptive_contrast: Option<f32>,
-    /// Pixels that took all `spp` samples.
+    /// Adaptive sampling of the reference mode: `spp` is then the mean.
+    pub adaptive_sampling: bool,
+    /// Pixels that took all `spp` samples (adaptive sampling: more than `spp`).
     pub refined_pixels: u64,
     /// Bounces.
     pub bounces: u32,
@@ -161,13 +166,14 @@ pub struct RenderSummary {
 impl std::fmt::Display for RenderSummary {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         let pixels = (u64::from(self.width) * u64::from(self.height)).max(1);
-        let spp = match self.adaptive_contrast {
-            Some(_) => format!(
-                "up to {} spp ({:.0} % of pixels refined)",
-                self.spp,
-                100.0 * self.refined_pixels as f64 / pixels as f64
+        let share = 100.0 * self.refined_pixels as f64 / pixels as f64;
+        let spp = match (self.adaptive_contrast, self.adaptive_sampling) {
+            (Some(_), _) => format!("up to {} spp ({share:.0} % of pixels refined)", self.spp),
+            (None, true) => format!(
+                "{} spp on average, adaptive ({share:.0} % of pixels took more)",
+                self.spp
             ),
-            None => format!("{} spp", self.spp),
+            (None, false) => format!("{} spp", self.spp),
         };
         let lights = self.lights.as_ref().map_or(String::new(), |l| {
             let ambient = l.ambient.as_ref().map_or(String::new(), |a| {
@@ -243,6 +249,8 @@ pub fn render_scene(job: &RenderJob, progress: &dyn Progress) -> Result<RenderSu
         seed: job.seed.unwrap_or(defaults.seed),
         sampler: job.sampler.unwrap_or(defaults.sampler),
         adaptive: defaults.adaptive.filter(|_| !job.no_adaptive),
+        adaptive_sampling: defaults.adaptive_sampling
+            || (job.adaptive_sampling && plan.mode == RenderMode::Reference),
         ..defaults
     };
     check_settings(&settings)?;
@@ -286,6 +294,7 @@ pub fn render_scene(job: &RenderJob, progress: &dyn Progress) -> Result<RenderSu
         adaptive_contrast: settings
             .adaptive
             .filter(|_| plan.mode != RenderMode::Reference),
+        adaptive_sampling: settings.adaptive_sampling,
         refined_pixels: stats.refined_pixels,
         bounces: settings.bounces,
         seed: settings.seed,

@@ -37,6 +37,7 @@ fn bench_rays(c: &mut Criterion) {
         seed: 1,
         sampler: SamplerKind::Sobol,
         adaptive: None,
+        adaptive_sampling: false,
     };
     let rays = render(&scene, &lighting, &settings, &|_, _| {})
         .expect("render")
@@ -73,6 +74,7 @@ fn bench_differential(c: &mut Criterion) {
         seed: 1,
         sampler: SamplerKind::Sobol,
         adaptive: None,
+        adaptive_sampling: false,
     };
     let mut group = c.benchmark_group("differential");
     group.sample_size(10);

@@ -37,7 +37,8 @@
 //!
 //! **Normal bins.** Any other surface draws from its normal's bin ([`crate::normal_bins`]), in
 //! proportion to radiance times a bound of its cosine, so its samples land above it and more of
-//! them where the cosine is large; [`SampleRegion::Facing`].
+//! them where the cosine is large; [`SampleRegion::Facing`]. Above a real floor that is all the
+//! real geometry, from the bin clipped to the upper half ([`EnvironmentLight::within_half`]).
 //!
 //! Texel look-up uses `theta = atan2(sqrt(x^2 + z^2), y)`, well conditioned at the poles, and
 //! `phi = atan2(x, -z)` in f32 (within about `2.4e-7` rad: a thousandth of a texel up to 8192
@@ -53,7 +54,7 @@ use ibl_core::rgb::Rgb64;
 use ibl_core::{Image, LatLong, Rgb};
 use rayon::prelude::*;
 
-use crate::normal_bins::NormalBins;
+use crate::normal_bins::{Half, NormalBins};
 use crate::sampling::{Distribution1D, UniformCone, cos_sin_turn};
 
 /// How far (as a fraction of a texel) sampled texel coordinates stay from the texel's edges.
@@ -145,7 +146,8 @@ pub enum SampleRegion {
     /// The probe's lower half, rows `floor(H / 2)..H`: for a surface facing the probe's -Y.
     Lower,
     /// The directions a surface whose normal falls in normal bin `k` can receive light from,
-    /// in proportion to radiance times a bound of the cosine ([`crate::normal_bins`]).
+    /// in proportion to radiance times a bound of the cosine ([`crate::normal_bins`]), or the
+    /// bin clipped to one half of the probe ([`EnvironmentLight::within_half`]).
     Facing(u16),
 }
 
@@ -371,14 +373,38 @@ impl EnvironmentLight {
         if !self.importance {
             return SampleRegion::Sphere;
         }
+        match self.half_facing(normal) {
+            Some(Half::Upper) => SampleRegion::Upper,
+            Some(Half::Lower) => SampleRegion::Lower,
+            None => self
+                .normal_bins
+                .bin_of(self.probe_from_world * normal)
+                .map_or(SampleRegion::Sphere, SampleRegion::Facing),
+        }
+    }
+
+    /// The probe's half that the world direction `normal` points into when it is exactly the
+    /// probe's up or down axis (its other two components exactly 0), else `None`.
+    pub fn half_facing(&self, normal: Vec3) -> Option<Half> {
         let n = self.probe_from_world * normal;
         match (n.x == 0.0 && n.z == 0.0, n.y) {
-            (true, y) if y > 0.0 => SampleRegion::Upper,
-            (true, y) if y < 0.0 => SampleRegion::Lower,
-            _ => self
+            (true, y) if y > 0.0 => Some(Half::Upper),
+            (true, y) if y < 0.0 => Some(Half::Lower),
+            _ => None,
+        }
+    }
+
+    /// `region` with its normal bin clipped to the probe's `half` ([`NormalBins::within`]): for
+    /// a vertex on that side of a real floor or ceiling that is all the real geometry, whose
+    /// other half meets the plane. Unchanged for any other region, and where none of the half's
+    /// light reaches the bin's normals.
+    pub fn within_half(&self, region: SampleRegion, half: Half) -> SampleRegion {
+        match region {
+            SampleRegion::Facing(bin) => self
                 .normal_bins
-                .bin_of(n)
-                .map_or(SampleRegion::Sphere, SampleRegion::Facing),
+                .within(bin, half)
+                .map_or(region, SampleRegion::Facing),
+            _ => region,
         }
     }
 

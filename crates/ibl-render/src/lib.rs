@@ -8,8 +8,10 @@
 //! - [`adaptive`]: adaptive antialiasing of the lights and hybrid modes.
 //! - [`background`]: the background at the output size.
 //! - [`environment`]: the probe as an importance-sampled environment light.
+//! - [`normal_bins`]: environment sampling by radiance times a cosine bound, per normal bin.
 //! - [`footprint`]: the probe's mean over a pinhole pixel's footprint (the background).
 //! - [`material`]: BSDFs of the scene's materials (evaluate, sample, density).
+//! - [`sample_allocation`]: adaptive sampling of the reference mode (unbiased).
 //! - [`sampler`]: the numbers each pixel sample draws (Owen-scrambled Sobol or independent).
 //! - [`sampling`]: random number generator, warps and discrete distributions.
 
@@ -21,6 +23,7 @@ pub mod lighting;
 pub mod material;
 pub mod normal_bins;
 pub mod render;
+pub mod sample_allocation;
 pub mod sampler;
 pub mod sampling;
 pub mod tracer;

@@ -30,6 +30,14 @@
 //! or hidden directions added. A bin whose `Z_b` is 0 (no light reaches any of its normals) is
 //! not offered ([`NormalBins::bin_of`] gives `None`).
 //!
+//! **Halves.** Each bin also has two clipped distributions, over the cells wholly in the probe's
+//! upper half (rows `0..ceil(H / 2)`) and wholly in its lower half (rows `floor(H / 2)..H`), with
+//! the same weights `P_c g(b, c)` and the others' set to 0 ([`NormalBins::within`]). A vertex
+//! above a real floor that is the whole real geometry draws from the upper one: every direction
+//! below the horizon meets the floor (but past its edge) and brings its light through the
+//! floor's own bounce, so a sample drawn there is wasted. Leaving directions out of one MIS
+//! strategy keeps the estimate unbiased wherever the other (the BSDF's) covers them.
+//!
 //! Cost: O(W H + B^2 C) to build (`C` cells), O(1) expected per sample and per density.
 
 use std::f64::consts::FRAC_PI_2;
@@ -50,6 +58,15 @@ const RADIUS_GRID: usize = 9;
 
 /// Added to every radius for rounding (rad).
 const RADIUS_MARGIN: f64 = 1e-4;
+
+/// Which half of the probe's sphere a clipped bin draws from (module notes, "Halves").
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Half {
+    /// Rows `0..ceil(H / 2)`: directions above the probe's horizontal plane.
+    Upper,
+    /// Rows `floor(H / 2)..H`: directions below it.
+    Lower,
+}
 
 /// A texel drawn by [`NormalBins::sample`], with two fresh uniform numbers for the direction
 /// inside it.
@@ -78,7 +95,9 @@ pub struct NormalBins {
     cell_row: Vec<u16>,
     /// Per cell (row-major), the distribution over its texels (row-major within the cell).
     cells: Vec<Distribution1D>,
-    /// Per bin, the distribution over cells; `None` where `Z_b = 0`.
+    /// Per bin, the distribution over cells; `None` where `Z_b = 0`. Then the same bins clipped
+    /// to the upper half's cells, then to the lower half's (ids `B^2 ..` and `2 B^2 ..`; module
+    /// notes, "Halves").
     bins: Vec<Option<Distribution1D>>,
 }
 
@@ -190,15 +209,24 @@ impl NormalBins {
                 })
             })
             .collect();
+        // The cell rows wholly in each half ("Halves").
+        let upper_rows = row_start.partition_point(|&r| r <= height.div_ceil(2)) - 1;
+        let lower_from = row_start.partition_point(|&r| r < height / 2);
+        let in_half = |cell: usize, half: Half| match half {
+            Half::Upper => cell / cw < upper_rows,
+            Half::Lower => cell / cw >= lower_from,
+        };
         let b = BINS_PER_SIDE as f64;
-        let bins = (0..BINS_PER_SIDE * BINS_PER_SIDE)
+        let weights_per_bin: Vec<Vec<f64>> = (0..BINS_PER_SIDE * BINS_PER_SIDE)
             .into_par_iter()
             .map(|k| {
                 let (bx, by) = ((k % BINS_PER_SIDE) as f64, (k / BINS_PER_SIDE) as f64);
                 let (axis, radius) =
                     bounding_cone(|s, t| octahedral_decode((bx + s) / b, (by + t) / b));
-                let bin = Distribution1D::new(cells.iter().zip(&cell_cones).map(
-                    |(cell, &(cell_axis, cell_radius))| {
+                cells
+                    .iter()
+                    .zip(&cell_cones)
+                    .map(|(cell, &(cell_axis, cell_radius))| {
                         let a = angle(axis, cell_axis) - radius - cell_radius;
                         let bound = if a >= FRAC_PI_2 {
                             0.0
@@ -206,10 +234,25 @@ impl NormalBins {
                             a.max(0.0).cos()
                         };
                         cell.total() * bound
-                    },
-                ));
+                    })
+                    .collect()
+            })
+            .collect();
+        let family = |half: Option<Half>| {
+            weights_per_bin.par_iter().map(move |weights| {
+                let bin = Distribution1D::new(weights.iter().enumerate().map(|(c, &w)| {
+                    if half.is_none_or(|half| in_half(c, half)) {
+                        w
+                    } else {
+                        0.0
+                    }
+                }));
                 (bin.total() > 0.0).then_some(bin)
             })
+        };
+        let bins = family(None)
+            .chain(family(Some(Half::Upper)))
+            .chain(family(Some(Half::Lower)))
             .collect();
         NormalBins {
             column_start,
@@ -235,6 +278,19 @@ impl NormalBins {
         let by = ((t * side) as usize).min(BINS_PER_SIDE - 1);
         let k = by * BINS_PER_SIDE + bx;
         self.bins[k].as_ref().map(|_| k as u16)
+    }
+
+    /// Bin `bin` ([`NormalBins::bin_of`]) clipped to the cells of `half` (module notes,
+    /// "Halves"); `None` when no light of that half reaches the bin's normals.
+    pub fn within(&self, bin: u16, half: Half) -> Option<u16> {
+        let bins = BINS_PER_SIDE * BINS_PER_SIDE;
+        let k = usize::from(bin);
+        let clipped = k + bins
+            * match half {
+                Half::Upper => 1,
+                Half::Lower => 2,
+            };
+        (k < bins && self.bins[clipped].is_some()).then_some(clipped as u16)
     }
 
     /// A texel drawn by bin `bin` from `u1` (the cell, then the texel's band) and `u2` (the

@@ -36,6 +36,7 @@ use crate::RenderError;
 use crate::adaptive::{CoarseGrid, FirstSample, needs_refinement};
 use crate::background::background_image;
 use crate::lighting::{Illumination, Lighting};
+use crate::sample_allocation::{PilotMoments, pilot_samples, sample_counts};
 use crate::sampler::{SOBOL_MAX_SAMPLES, SampleStream, SamplerKind};
 use crate::tracer::{KnownVisibility, Layers, LightVisibility, PrimaryHit, ShadowHints, Tracer};
 
@@ -59,6 +60,10 @@ pub struct RenderSettings {
     /// and all `spp` only where its neighbourhood shows a contrast above `c` or a silhouette;
     /// `None` gives every pixel `spp`. Ignored by the reference mode, which stays unbiased.
     pub adaptive: Option<f32>,
+    /// Adaptive sampling of the reference mode ([`crate::sample_allocation`]): the paths of
+    /// `spp` per pixel spent where the pilot pass finds noise, still unbiased. Ignored by the
+    /// lights and hybrid modes.
+    pub adaptive_sampling: bool,
 }
 
 impl RenderSettings {
@@ -77,6 +82,7 @@ impl RenderSettings {
             bounces: r.bounces,
             seed: r.seed,
             sampler: r.sampler,
+            adaptive_sampling: mode == RenderMode::Reference && r.adaptive_sampling,
             adaptive: match mode {
                 RenderMode::Reference => None,
                 RenderMode::Lights | RenderMode::Hybrid => scene
@@ -98,7 +104,8 @@ pub struct RenderStats {
     /// Samples per pixel (the most a pixel takes, with adaptive antialiasing).
     pub spp: u32,
     /// Pixels that took all `spp` samples: every pixel without adaptive antialiasing, those
-    /// whose first samples showed contrast with it.
+    /// whose first samples showed contrast with it; with adaptive sampling, those that took
+    /// more than `spp`.
     pub refined_pixels: u64,
     /// Paths traced with the objects.
     pub paths: u64,
@@ -146,6 +153,10 @@ struct PixelSums {
     background_samples: u32,
     paths_without: u64,
     rays: u64,
+    /// Sum and sum of squares of the traced samples' luminance with the objects (adaptive
+    /// sampling's pilot; background samples are added when it is read).
+    luminance: f64,
+    luminance_squares: f64,
 }
 
 /// Renders `scene` under `lighting` and composites it into the background. `progress(rows_done,
@@ -193,9 +204,39 @@ pub fn render(
         settings.spp > 1 && !matches!(lighting.illumination, Illumination::Environment)
     });
     let rows_done = AtomicUsize::new(0);
-    let passes = if adaptive.is_some() { 2 } else { 1 };
+    // Adaptive sampling: only the reference, and only when the pilot leaves samples to share.
+    let pilot = pilot_samples(settings.spp);
+    let allocate = settings.adaptive_sampling
+        && pilot < settings.spp
+        && matches!(lighting.illumination, Illumination::Environment);
+    let passes = if adaptive.is_some() || allocate { 2 } else { 1 };
     let row_done = || progress(rows_done.fetch_add(1, Ordering::Relaxed) + 1, passes * h);
     let sums: Vec<PixelSums> = match adaptive {
+        None if allocate => {
+            // Pass 1: the pilot; pass 2: each pixel up to its count (crate::sample_allocation).
+            let known = &KnownVisibility::NONE;
+            let mut sums = per_pixel(w, h, &row_done, |x, y, hints| {
+                sampler.samples(x, y, 0..pilot, hints, known)
+            });
+            let delta = 0.1 * mean_luminance(&background);
+            let pilots: Vec<PilotMoments> = sums
+                .par_iter()
+                .zip(background.pixels().par_iter())
+                .map(|(sums, b)| sums.pilot(*b))
+                .collect();
+            let variance: Vec<f64> = pilots.iter().map(|p| p.relative_variance(delta)).collect();
+            let cost: Vec<f64> = pilots.iter().map(PilotMoments::cost).collect();
+            let counts = sample_counts(&variance, &cost, w, h, settings.spp, pilot);
+            sums.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+                let mut hints = ShadowHints::default();
+                for (x, pixel) in row.iter_mut().enumerate() {
+                    let samples = pilot..counts[y * w + x];
+                    sampler.add_samples(pixel, x, y, samples, &mut hints, known);
+                }
+                row_done();
+            });
+            sums
+        }
         None => per_pixel(w, h, &row_done, |x, y, hints| {
             sampler.samples(x, y, 0..settings.spp, hints, &KnownVisibility::NONE)
         }),
@@ -242,7 +283,11 @@ pub fn render(
     for sums in &sums {
         object_samples += u64::from(sums.object_samples);
         stats.paths += u64::from(sums.samples);
-        stats.refined_pixels += u64::from(sums.samples == settings.spp);
+        stats.refined_pixels += u64::from(if allocate {
+            sums.samples > settings.spp
+        } else {
+            sums.samples == settings.spp
+        });
         stats.paths_without_objects += sums.paths_without;
         stats.rays += sums.rays;
     }
@@ -274,6 +319,13 @@ pub fn render(
             .map_err(|e| RenderError::Parameter(e.to_string()))?,
         stats,
     })
+}
+
+/// The mean luminance of `image` (0 for an empty one), in f64.
+fn mean_luminance(image: &Image<Rgb>) -> f64 {
+    let pixels = image.pixels();
+    let sum: f64 = pixels.par_iter().map(|p| f64::from(p.luminance())).sum();
+    sum / pixels.len().max(1) as f64
 }
 
 /// Largest output, pixels (a 16384 x 8192 panorama).
@@ -345,6 +397,18 @@ impl PixelSums {
             }
         };
         c.map(|v| v.max(0.0))
+    }
+
+    /// The luminance moments of the pixel's samples over background `b` (adaptive sampling).
+    fn pilot(&self, b: Rgb) -> PilotMoments {
+        let background = f64::from(b.luminance());
+        let escaped = f64::from(self.background_samples);
+        PilotMoments {
+            count: self.samples,
+            sum: self.luminance + escaped * background,
+            sum_of_squares: self.luminance_squares + escaped * background * background,
+            rays: self.rays,
+        }
     }
 
     /// What the pixel's one sample saw (adaptive antialiasing's first pass).
@@ -421,6 +485,11 @@ impl PixelSampler<'_> {
             let with = tracer.trace(ray, Layers::WithObjects, &mut rng, hints, known);
             if sums.samples == 1 {
                 sums.first_visibility = with.visibility;
+            }
+            if with.primary != PrimaryHit::Background {
+                let y = f64::from(with.radiance.luminance());
+                sums.luminance += y;
+                sums.luminance_squares += y * y;
             }
             sums.rays += with.rays;
             match with.primary {

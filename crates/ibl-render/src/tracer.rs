@@ -5,7 +5,8 @@
 //!   diffuse or glossy vertex one environment sample (importance-sampled by texel power, from the
 //!   probe's upper or lower half alone where the surface faces one of its poles exactly, a floor
 //!   or a ceiling, else from its normal's bin, radiance times a bound of the cosine:
-//!   [`crate::environment::EnvironmentLight::region_for`]) and the BSDF sample that continues
+//!   [`crate::environment::EnvironmentLight::region_for`], clipped to the half above the floor
+//!   on a virtual object standing on a real floor that is all the real geometry) and the BSDF sample that continues
 //!   the path are combined by the power heuristic (Veach 1997, multiple importance sampling); an
 //!   escaping BSDF sample adds the probe's radiance with the complementary weight. A diffuse
 //!   floor in a scene whose real geometry is one plane takes its exact unshadowed light instead
@@ -64,6 +65,7 @@ use rayon::prelude::*;
 use crate::environment::{EnvironmentLight, SampleRegion};
 use crate::lighting::{Ambient, Illumination, LightList, Lighting, RayRole};
 use crate::material::Bsdf;
+use crate::normal_bins::Half;
 use crate::sampler::SampleStream;
 use crate::sampling::{LightShading, OrthonormalBasis, power_heuristic, sample_cosine_hemisphere};
 
@@ -236,18 +238,29 @@ struct EnvironmentStrategy {
 }
 
 impl EnvironmentStrategy {
-    /// The strategy at `surface`, seen from a vertex whose BSDF value is `lambertian`
-    /// ([`Bsdf::lambertian`]); `open` when the real geometry is one plane.
+    /// The strategy at `surface` (on a virtual object when `is_virtual`), seen from a vertex
+    /// whose BSDF value is `lambertian` ([`Bsdf::lambertian`]); `real_plane` when the real
+    /// geometry is one plane. A virtual vertex off that plane draws from its normal's bin
+    /// clipped to the half on its side ([`RealPlane::open_half`]): the other half meets the
+    /// plane (but past its edge, which the BSDF sample alone covers), and its light arrives
+    /// through the plane's own bounce.
     fn at(
         env: &EnvironmentLight,
         surface: &SurfacePoint,
         lambertian: Option<Rgb>,
-        open: bool,
+        real_plane: Option<&RealPlane>,
+        is_virtual: bool,
     ) -> Self {
-        let region = env.region_for(surface.geometric_normal);
+        let mut region = env.region_for(surface.geometric_normal);
+        if let Some(half) = real_plane
+            .filter(|_| is_virtual)
+            .and_then(|plane| plane.open_half(env, surface.position))
+        {
+            region = env.within_half(region, half);
+        }
         let flat = surface.shading_normal == surface.geometric_normal;
         let unshadowed = match (lambertian, env.half_irradiance(region)) {
-            (Some(f), Some(irradiance)) if flat && open => Some(f * irradiance),
+            (Some(f), Some(irradiance)) if flat && real_plane.is_some() => Some(f * irradiance),
             _ => None,
         };
         EnvironmentStrategy { region, unshadowed }
@@ -362,9 +375,34 @@ pub struct Tracer<'a> {
     bounces: u32,
     /// Per light of the lighting's light list, its cones' shading tables (soft shadows only).
     cone_shading: Vec<Option<LightShading>>,
-    /// Whether every real triangle lies in one plane (a ground): then no ray leaving a real
-    /// surface towards its geometric normal's side can meet the real layer.
-    flat_real_layer: bool,
+    /// The plane of the real triangles when they all lie in one (a ground): then no ray leaving
+    /// a real surface towards its geometric normal's side can meet the real layer.
+    real_plane: Option<RealPlane>,
+}
+
+/// The one plane all real triangles lie in ([`flat_plane`]).
+#[derive(Clone, Copy, Debug)]
+struct RealPlane {
+    /// A point of the plane (world, m).
+    point: Vec3,
+    /// Its unit normal (world; either side).
+    normal: Vec3,
+}
+
+impl RealPlane {
+    /// The probe half ([`EnvironmentLight::half_facing`]) on `position`'s side of the plane,
+    /// away from it: where a ray from there can leave without meeting the plane (up to its
+    /// edge). `None` on the plane, or where the normal is not the probe's vertical axis.
+    fn open_half(&self, env: &EnvironmentLight, position: Vec3) -> Option<Half> {
+        let side = self.normal.dot(position - self.point);
+        if side > 0.0 {
+            env.half_facing(self.normal)
+        } else if side < 0.0 {
+            env.half_facing(-self.normal)
+        } else {
+            None
+        }
+    }
 }
 
 /// Vertex count from which Russian roulette may end a path.
@@ -380,7 +418,7 @@ struct PathState<'h> {
     known: LightVisibility,
     /// The answers at the vertex being shaded (camera hits only).
     seen: LightVisibility,
-    /// The vertex being shaded lies on a flat real layer ([`Tracer`]'s `flat_real_layer`): its
+    /// The vertex being shaded lies on a flat real layer ([`Tracer`]'s `real_plane`): its
     /// rays, which all leave towards the geometric normal's side, skip the real layer.
     on_flat_real: bool,
 }
@@ -426,7 +464,7 @@ impl<'a> Tracer<'a> {
             lighting,
             bounces: bounces.max(1),
             cone_shading,
-            flat_real_layer: is_flat(&scene.real.triangles),
+            real_plane: flat_plane(&scene.real.triangles),
         }
     }
 
@@ -479,7 +517,7 @@ impl<'a> Tracer<'a> {
                 radiance =
                     radiance - throughput * self.bsdf_share(ray.direction, pdf, strategy.region);
             }
-            state.on_flat_real = self.flat_real_layer && !is_virtual;
+            state.on_flat_real = self.real_plane.is_some() && !is_virtual;
             if vertex == 0 {
                 primary = if is_virtual {
                     PrimaryHit::Virtual
@@ -510,8 +548,21 @@ impl<'a> Tracer<'a> {
                             &self.lighting.environment,
                             &surface,
                             vertex.lambertian,
-                            self.flat_real_layer,
+                            self.real_plane.as_ref(),
+                            is_virtual,
                         );
+                        if let Some(unshadowed) = strategy.unshadowed
+                            && state.layers == Layers::RealOnly
+                            && state.on_flat_real
+                        {
+                            // Without the objects nothing shadows a vertex on the one real
+                            // plane (its rays skip the plane, and the luminaires are new
+                            // lights): the control variate is its exact light, and its BSDF
+                            // sample can only escape, adding nothing. The walk ends here, with
+                            // the value the samples would have given.
+                            radiance += throughput * unshadowed;
+                            break;
+                        }
                         let none = LayeredLight::none(&state);
                         let luminaires = self.luminaires(&vertex, &mut state, none);
                         new_light += throughput * luminaires.with;
@@ -994,18 +1045,16 @@ impl<'a> Tracer<'a> {
     }
 }
 
-/// Whether all of `triangles` lie in one plane, to 1e-6 of their extent (false when there are
-/// none or all are degenerate): the plane of the first triangle with an area, every corner
-/// checked against it. A ray leaving such a layer's surface on the side it leaves cannot meet
+/// The plane all of `triangles` lie in, to 1e-6 of their extent (`None` when they do not, when
+/// there are none or all are degenerate): the plane of the first triangle with an area, every
+/// corner checked against it. A ray leaving such a layer's surface on the side it leaves cannot meet
 /// the layer again (the intersection test would reject the hit at `t = 0` anyway); the
 /// tolerance is far below the rays' origin offsets' effect on anything but grazing rays.
-fn is_flat(triangles: &[[Vec3; 3]]) -> bool {
-    let Some((normal, corner)) = triangles.iter().find_map(|[a, b, c]| {
+fn flat_plane(triangles: &[[Vec3; 3]]) -> Option<RealPlane> {
+    let (normal, corner) = triangles.iter().find_map(|[a, b, c]| {
         let n = (*b - *a).cross(*c - *a);
         (n.length_squared() > 0.0).then(|| (n.normalize(), *a))
-    }) else {
-        return false;
-    };
+    })?;
     let extent = triangles
         .iter()
         .flatten()
@@ -1016,6 +1065,10 @@ fn is_flat(triangles: &[[Vec3; 3]]) -> bool {
         .iter()
         .flatten()
         .all(|p| normal.dot(*p - corner).abs() <= tolerance)
+        .then_some(RealPlane {
+            point: corner,
+            normal,
+        })
 }
 
 /// How far above the shading horizon [`cone_bsdf`] reads a lobe whose cone axis is below it
@@ -1096,15 +1149,17 @@ mod tests {
                 Vec3::new(-20.0, -1.0, 20.0),
             ],
         ];
-        assert!(is_flat(&quad));
+        let plane = flat_plane(&quad).expect("flat");
+        assert_eq!(plane.normal.abs(), Vec3::Y);
+        assert_eq!(plane.point.y, -1.0);
         // A tilted plane through rounding.
         let tilt = glam::Quat::from_rotation_x(0.3);
         let tilted: Vec<[Vec3; 3]> = quad.iter().map(|t| t.map(|p| tilt * p)).collect();
-        assert!(is_flat(&tilted));
+        assert!(flat_plane(&tilted).is_some());
         let mut bent = quad;
         bent[1][2].y = -0.99;
-        assert!(!is_flat(&bent));
-        assert!(!is_flat(&[]));
-        assert!(!is_flat(&[[Vec3::ZERO; 3]]));
+        assert!(flat_plane(&bent).is_none());
+        assert!(flat_plane(&[]).is_none());
+        assert!(flat_plane(&[[Vec3::ZERO; 3]]).is_none());
     }
 }

@@ -84,6 +84,7 @@ fn settings(composite: CompositeRule, bounces: u32) -> RenderSettings {
         seed: 1,
         sampler: SamplerKind::Sobol,
         adaptive: None,
+        adaptive_sampling: false,
     }
 }
 

@@ -61,6 +61,7 @@ fn the_contact_shadow_does_not_depend_on_the_size_of_the_ground() {
         seed: 3,
         sampler: SamplerKind::Sobol,
         adaptive: None,
+        adaptive_sampling: false,
     };
     let mean_ground = |size: f32| {
         let scene = bunny_on_ground(size);

@@ -216,6 +216,7 @@ fn settings(spp: u32, seed: u64) -> RenderSettings {
         seed,
         sampler: SamplerKind::Sobol,
         adaptive: None,
+        adaptive_sampling: false,
     }
 }
 

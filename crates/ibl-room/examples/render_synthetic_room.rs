@@ -72,6 +72,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             seed,
             sampler: ibl_render::SamplerKind::Sobol,
             adaptive: None,
+            adaptive_sampling: false,
         };
         let out = render(&scene, &lighting, &settings, &|done, total| {
             if done % 64 == 0 || done == total {

@@ -153,6 +153,7 @@ fn render_halves(
             seed,
             sampler: SamplerKind::Sobol,
             adaptive: None,
+            adaptive_sampling: false,
         };
         render(&scene, &lighting, &settings, &|_, _| ())
             .expect("render")

@@ -75,6 +75,7 @@ fn compare_model(name: &str, model: SceneModel) -> Option<(Image<Rgb>, Image<Rgb
         seed: 1,
         sampler: scene.render.sampler,
         adaptive: None,
+        adaptive_sampling: false,
     };
     let cpu = render(scene, &lighting, &settings, &|_, _| {}).expect("cpu renders");
     let cpu_seconds = started.elapsed().as_secs_f64();

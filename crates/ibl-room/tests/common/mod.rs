@@ -121,6 +121,7 @@ pub fn render_with_objects(
             seed,
             sampler: SamplerKind::Sobol,
             adaptive: None,
+            adaptive_sampling: false,
         };
         render(&scene, &lighting, &settings, &|_, _| ()).expect("render")
     })

@@ -1,5 +1,5 @@
 //! `[render]`: the renderer's settings (mode, size, samples, bounces, seed, composite rule,
-//! sampler); the command line overrides them. Limits on each setting are here.
+//! sampler, adaptive sampling); the command line overrides them. Limits on each setting are here.
 
 use serde::{Deserialize, Serialize};
 
@@ -29,6 +29,11 @@ pub struct RenderDescription {
     /// Which random numbers the samples draw. Default `sobol`.
     #[serde(default)]
     pub sampler: SamplerKind,
+    /// Adaptive sampling of the reference mode: the same paths in all, more of them where a
+    /// pilot pass finds noise, still unbiased (`ibl-render`'s `sample_allocation`). Default
+    /// false.
+    #[serde(default)]
+    pub adaptive_sampling: bool,
 }
 
 /// Which random numbers a render's samples draw (every mode).
@@ -97,6 +102,7 @@ impl Default for RenderDescription {
             seed: default_seed(),
             composite: CompositeRule::default(),
             sampler: SamplerKind::default(),
+            adaptive_sampling: false,
         }
     }
 }
