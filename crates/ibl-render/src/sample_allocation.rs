@@ -7,26 +7,25 @@
 //! of it costs `c_i` (its paths' rays: one on a quiet floor, several on an object), and for a
 //! fixed cost `sum_i c_i n_i` the sum `sum_i sigma_i^2 / n_i` is least at `n_i ~ sigma_i /
 //! sqrt(c_i)` (Lagrange), so the noisy pixels should take more than their share and the quiet
-//! ones less, the more so the cheaper they are. Here `sigma_i` is
-//! measured relative to the pixel's brightness, `sigma_i^2 = Var(Y) / (mean(Y)^2 + delta^2)`
-//! (`Y` a sample's luminance with the objects, the background's where the camera ray escaped;
-//! `delta` a tenth of the background's mean luminance, so black pixels do not divide by 0),
-//! because relative noise is what the eye and the benchmarks' relative MSE see.
+//! ones less, the more so the cheaper they are. Here `sigma_i` is measured relative to the
+//! pixel's brightness, `sigma_i^2 = Var(Y) / (mean(Y)^2 + delta^2)` (`Y` a sample's luminance
+//! with the objects, the background's where the camera ray escaped; `delta` a tenth of the
+//! background's mean luminance, so black pixels do not divide by 0), because relative noise is
+//! what the eye and the benchmarks' relative MSE see.
 //!
 //! **Two passes.** Every pixel first takes a pilot of `n_0 = max(2, spp / 8)` samples (samples
 //! `0..n_0` of its stream), from which its `sigma_i^2` and `c_i` (rays per sample) are
-//! estimated. It then takes samples
-//! `n_0..n_i`, and its value is the mean of all `n_i`.
+//! estimated. It then takes samples `n_0..n_i`, and its value is the mean of all `n_i`.
 //!
 //! **Unbiased.** A pixel's count must not depend on its own samples: a pixel whose pilot drew a
 //! rare bright path would otherwise take more samples and dilute it, and the mean over the
 //! renders would fall short. So the pixels are split like a chessboard, and a pixel's count is
 //! computed from the pilots of the other colour only: its score `s_i` is the root of the mean
 //! `sigma_j^2` over the mean `c_j` of the other colour's pixels in its 5 x 5 neighbourhood (which
-//! also smooths the pilot's noisy estimates), and the counts of one colour are normalised over that colour alone
-//! with its own (other-colour) scores. Samples of different pixels are independent (each pixel
-//! scrambles its own stream), so `E[mean | n_i] = mu_i` and the estimate is unbiased for any
-//! allocation rule.
+//! also smooths the pilot's noisy estimates), and the counts of one colour are normalised over
+//! that colour alone with its own (other-colour) scores. Samples of different pixels are
+//! independent (each pixel scrambles its own stream), so `E[mean | n_i] = mu_i` and the
+//! estimate is unbiased for any allocation rule.
 //!
 //! **Counts.** Each colour `C` takes the cost of `spp - n_0` further samples per pixel, `(spp -
 //! n_0) sum_C c_j` with its pixels' costs `c_j` as the pilots around them measured them: a

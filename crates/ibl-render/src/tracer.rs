@@ -6,9 +6,10 @@
 //!   probe's upper or lower half alone where the surface faces one of its poles exactly, a floor
 //!   or a ceiling, else from its normal's bin, radiance times a bound of the cosine:
 //!   [`crate::environment::EnvironmentLight::region_for`], clipped to the half above the floor
-//!   on a virtual object standing on a real floor that is all the real geometry) and the BSDF sample that continues
-//!   the path are combined by the power heuristic (Veach 1997, multiple importance sampling); an
-//!   escaping BSDF sample adds the probe's radiance with the complementary weight. A diffuse
+//!   on a virtual object standing on a real floor that is all the real geometry) and the BSDF
+//!   sample that continues the path are combined by the power heuristic (Veach 1997, multiple
+//!   importance sampling); an escaping BSDF sample adds the probe's radiance with the
+//!   complementary weight. A diffuse
 //!   floor in a scene whose real geometry is one plane takes its exact unshadowed light instead
 //!   and subtracts what the two samples find blocked (`EnvironmentStrategy`, a control
 //!   variate). Mirrors are delta: escaping mirror rays add the probe unweighted. Paths stop after
@@ -1047,8 +1048,8 @@ impl<'a> Tracer<'a> {
 
 /// The plane all of `triangles` lie in, to 1e-6 of their extent (`None` when they do not, when
 /// there are none or all are degenerate): the plane of the first triangle with an area, every
-/// corner checked against it. A ray leaving such a layer's surface on the side it leaves cannot meet
-/// the layer again (the intersection test would reject the hit at `t = 0` anyway); the
+/// corner checked against it. A ray leaving such a layer's surface on the side it leaves cannot
+/// meet the layer again (the intersection test would reject the hit at `t = 0` anyway); the
 /// tolerance is far below the rays' origin offsets' effect on anything but grazing rays.
 fn flat_plane(triangles: &[[Vec3; 3]]) -> Option<RealPlane> {
     let (normal, corner) = triangles.iter().find_map(|[a, b, c]| {
