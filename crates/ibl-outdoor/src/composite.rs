@@ -159,7 +159,8 @@ impl FrameCompositor {
         let mut scene = self.scene.clone();
         scene.background = Background::Photo(frame.clone());
         scene.probe.radiance = lighting.relit_map.clone();
-        let environment = EnvironmentLight::new(
+        // The hybrid mode draws no environment samples: no normal bins (most of the build).
+        let environment = EnvironmentLight::without_normal_bins(
             lighting.relit_map.clone(),
             scene.probe.world_from_probe,
             1.0,

@@ -406,19 +406,21 @@ pub struct Lighting {
 }
 
 impl Lighting {
-    /// The environment of `scene`'s probe.
-    fn environment(scene: &Scene) -> Result<EnvironmentLight, EnvironmentError> {
-        EnvironmentLight::new(
-            scene.probe.radiance.clone(),
-            scene.probe.world_from_probe,
-            1.0,
-        )
+    /// The environment of `scene`'s probe; with its normal bins only for the reference, whose
+    /// surfaces draw environment samples ([`EnvironmentLight::without_normal_bins`]).
+    fn environment(scene: &Scene, sampled: bool) -> Result<EnvironmentLight, EnvironmentError> {
+        let (probe, frame) = (scene.probe.radiance.clone(), scene.probe.world_from_probe);
+        if sampled {
+            EnvironmentLight::new(probe, frame, 1.0)
+        } else {
+            EnvironmentLight::without_normal_bins(probe, frame, 1.0)
+        }
     }
 
     /// Reference lighting: the full probe.
     pub fn reference(scene: &Scene) -> Result<Lighting, EnvironmentError> {
         Ok(Lighting {
-            environment: Self::environment(scene)?,
+            environment: Self::environment(scene, true)?,
             illumination: Illumination::Environment,
             luminaires: scene.luminaires.clone(),
         })
@@ -431,7 +433,7 @@ impl Lighting {
         shadows: ShadowKind,
     ) -> Result<Lighting, EnvironmentError> {
         Ok(Lighting {
-            environment: Self::environment(scene)?,
+            environment: Self::environment(scene, false)?,
             illumination: Illumination::Lights(light_list(scene, set, shadows)),
             luminaires: scene.luminaires.clone(),
         })
@@ -464,7 +466,7 @@ impl Lighting {
             ambient = ambient.with_horizon_halves(up, &halves.rotated(rotation));
         }
         Ok(Lighting {
-            environment: Self::environment(scene)?,
+            environment: Self::environment(scene, false)?,
             illumination: Illumination::Hybrid(light_list(scene, set, shadows), ambient),
             luminaires: scene.luminaires.clone(),
         })

@@ -432,16 +432,47 @@ fn clamped_cosine_integral(omc: f64, cos_beta: f64) -> f64 {
 /// largest power of two not above `n`) equal steps of `u`, the table holds the cell where each
 /// step starts, so a draw searches only the cells its step spans, usually one or two. The answer
 /// is the plain binary search's, bit for bit, and the map from `u` to the cell stays monotone, so
-/// low-discrepancy points keep their stratification (an alias table would not).
+/// low-discrepancy points keep their stratification (an alias table would not). The table holds
+/// 16-bit cell indices when there are at most `2^16` cells (every probe row, normal bin and cell
+/// of the renderer's tables): a draw is memory-bound (its first read, the table, usually misses
+/// the cache), and the narrower table halves the lines the tables take.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Distribution1D {
     /// `n + 1` non-decreasing values, `cdf[0] = 0`, `cdf[n] = 1`.
     cdf: Vec<f32>,
-    /// `G + 1` entries: `guide[k]` is the last cell `i < n` with `cdf[i] <= k / G` (exact in
+    /// `G + 1` entries: entry `k` is the last cell `i < n` with `cdf[i] <= k / G` (exact in
     /// f64, `G` a power of two). Empty when `n = 0`.
-    guide: Vec<u32>,
+    guide: GuideTable,
     /// Sum of the weights (f64).
     total: f64,
+}
+
+/// A [`Distribution1D`]'s guide table, its cell indices as narrow as they fit.
+#[derive(Clone, Debug, PartialEq)]
+enum GuideTable {
+    /// At most `2^16` cells.
+    Narrow(Vec<u16>),
+    /// More.
+    Wide(Vec<u32>),
+}
+
+impl GuideTable {
+    /// Number of entries (`G + 1`, or 0).
+    fn len(&self) -> usize {
+        match self {
+            GuideTable::Narrow(t) => t.len(),
+            GuideTable::Wide(t) => t.len(),
+        }
+    }
+
+    /// The first and last cells that step `k` spans (`k < G`).
+    #[inline]
+    fn step(&self, k: usize) -> (usize, usize) {
+        match self {
+            GuideTable::Narrow(t) => (usize::from(t[k]), usize::from(t[k + 1])),
+            GuideTable::Wide(t) => (t[k] as usize, t[k + 1] as usize),
+        }
+    }
 }
 
 /// One draw from a [`Distribution1D`].
@@ -528,8 +559,7 @@ impl Distribution1D {
         // power of two below 2^32), and the cells that step spans.
         let steps = self.guide.len() - 1;
         let k = ((f64::from(u) * steps as f64) as usize).min(steps - 1);
-        let first = self.guide[k] as usize;
-        let last = self.guide[k + 1] as usize;
+        let (first, last) = self.guide.step(k);
         let index = first + self.cdf[first + 1..=last].partition_point(|&c| c <= u);
         let lo = self.cdf[index];
         let probability = self.cdf[index + 1] - lo;
@@ -545,23 +575,31 @@ impl Distribution1D {
 /// The guide table of a CDF of `n + 1` entries (`cdf[0] = 0`, `cdf[n] = 1`, non-decreasing):
 /// `G + 1` entries for `G` the largest power of two `<= n`, entry `k` the last cell `i < n` with
 /// `cdf[i] <= k / G`. Empty for `n = 0`. O(n).
-fn guide_table(cdf: &[f32]) -> Vec<u32> {
+fn guide_table(cdf: &[f32]) -> GuideTable {
     let n = cdf.len().saturating_sub(1);
     if n == 0 {
-        return Vec::new();
+        return GuideTable::Narrow(Vec::new());
     }
     let steps = 1usize << n.ilog2();
     let mut cell = 0usize;
-    (0..=steps)
-        .map(|k| {
-            let threshold = k as f64 / steps as f64;
-            while cell + 1 < n && f64::from(cdf[cell + 1]) <= threshold {
-                cell += 1;
-            }
-            // Cells are fewer than 2^32: the image limits bound `n` by 2^28.
-            u32::try_from(cell).unwrap_or(u32::MAX)
-        })
-        .collect()
+    let starts = (0..=steps).map(move |k| {
+        let threshold = k as f64 / steps as f64;
+        while cell + 1 < n && f64::from(cdf[cell + 1]) <= threshold {
+            cell += 1;
+        }
+        cell
+    });
+    if n <= 1 << 16 {
+        // Cells below `2^16`.
+        GuideTable::Narrow(starts.map(|c| c as u16).collect())
+    } else {
+        // Cells are fewer than 2^32: the image limits bound `n` by 2^28.
+        GuideTable::Wide(
+            starts
+                .map(|c| u32::try_from(c).unwrap_or(u32::MAX))
+                .collect(),
+        )
+    }
 }
 
 /// Veach's power heuristic (exponent 2) for one sample from each of two techniques: the weight of
@@ -608,7 +646,8 @@ mod tests {
     #[test]
     fn guided_search_equals_the_plain_binary_search() {
         // Weights with runs of zeros, one dominant cell and tiny ones, at sizes around powers of
-        // two; `u` on a fine grid, at every CDF value and just either side of it.
+        // two (65536 and 65537: the last narrow table and the first wide one); `u` on a fine
+        // grid, at every CDF value and just either side of it.
         let mut state = 0x9e37_79b9_7f4a_7c15_u64;
         let mut next = || {
             state ^= state << 13;
@@ -616,7 +655,21 @@ mod tests {
             state ^= state << 17;
             (state >> 11) as f64 / (1u64 << 53) as f64
         };
-        for n in [1usize, 2, 3, 7, 8, 9, 63, 64, 65, 500, 1024] {
+        for n in [
+            1usize,
+            2,
+            3,
+            7,
+            8,
+            9,
+            63,
+            64,
+            65,
+            500,
+            1024,
+            1 << 16,
+            (1 << 16) + 1,
+        ] {
             let weights: Vec<f64> = (0..n)
                 .map(|i| match i % 7 {
                     0 | 3 => 0.0,

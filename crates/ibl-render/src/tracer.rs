@@ -677,11 +677,17 @@ impl<'a> Tracer<'a> {
     ) -> Rgb {
         let env = &self.lighting.environment;
         let [u1, u2] = stream.next_2d();
-        let sample = env.sample_in(strategy.region, u1, u2);
-        let wi = sample.direction;
-        let reflection = (sample.pdf_sr > 0.0)
-            .then(|| vertex.reflection(wi))
-            .flatten();
+        let drawn = env.direction_in(strategy.region, u1, u2);
+        let wi = drawn.direction;
+        // Plain MIS needs the sample's density before its shadow ray; a control-variate vertex
+        // reads the texel only where the ray is blocked (most of its samples are open and add
+        // nothing), which spares a cache miss into the probe per floor vertex.
+        let sample = strategy
+            .unshadowed
+            .is_none()
+            .then(|| env.texel_of_draw(drawn));
+        let possible = sample.is_none_or(|s| s.pdf_sr > 0.0);
+        let reflection = possible.then(|| vertex.reflection(wi)).flatten();
         // Plain MIS adds the sample's light where its shadow ray is open; the control variate
         // ([`EnvironmentStrategy::unshadowed`]) takes it off where the ray is blocked. A sample
         // that could not light the vertex (zero density, below the surface) does neither.
@@ -690,8 +696,13 @@ impl<'a> Tracer<'a> {
                 if (self.occlusion(above(vertex.surface), wi, state) == Occlusion::Open)
                     != strategy.unshadowed.is_some() =>
             {
-                let weight = power_heuristic(sample.pdf_sr, vertex.bsdf.pdf(vertex.wo, wi));
-                f_cos * sample.radiance * (weight / sample.pdf_sr)
+                let sample = sample.unwrap_or_else(|| env.texel_of_draw(drawn));
+                if sample.pdf_sr > 0.0 {
+                    let weight = power_heuristic(sample.pdf_sr, vertex.bsdf.pdf(vertex.wo, wi));
+                    f_cos * sample.radiance * (weight / sample.pdf_sr)
+                } else {
+                    Rgb::ZERO
+                }
             }
             _ => Rgb::ZERO,
         };
