@@ -111,6 +111,12 @@ impl Bsdf {
         matches!(self.lobes, Lobes::Mirror { .. })
     }
 
+    /// Whether [`Bsdf::sample`] reads its first number (the choice between a glossy BSDF's two
+    /// lobes); a diffuse or mirror BSDF ignores it, so a caller may skip drawing it.
+    pub fn chooses_lobe(&self) -> bool {
+        matches!(self.lobes, Lobes::Glossy { .. })
+    }
+
     /// `f = albedo / pi` when the BSDF is purely diffuse and `wo` is on the surface's side: then
     /// `eval(wo, wi)` is that value for every `wi` above both the shading and the geometric
     /// surface (and 0 below), so a caller lighting one point from many directions can read it

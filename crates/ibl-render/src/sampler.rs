@@ -238,6 +238,18 @@ impl SampleStream {
         }
     }
 
+    /// Passes over the next number without computing it: the later draws are those after a
+    /// [`SampleStream::next_1d`] (a Sobol pair's hashes and scrambles, or one PCG step).
+    #[inline]
+    pub fn skip_1d(&mut self) {
+        match self {
+            SampleStream::Sobol(s) => s.skip_2d(),
+            SampleStream::Independent(r) => {
+                r.next_f32();
+            }
+        }
+    }
+
     /// Passes over the next pair (two numbers of the independent stream) without using it:
     /// the later draws are those after a [`SampleStream::next_2d`].
     #[inline]
@@ -320,12 +332,17 @@ mod tests {
     }
 
     #[test]
-    fn a_skipped_pair_leaves_the_later_draws_unchanged() {
+    fn a_skipped_pair_or_number_leaves_the_later_draws_unchanged() {
         for kind in [SamplerKind::Sobol, SamplerKind::Independent] {
             let mut drawn = SampleStream::new(kind, 7, 11, 3);
             let mut skipped = drawn.clone();
             drawn.next_2d();
             skipped.skip_2d();
+            assert_eq!(drawn.next_2d(), skipped.next_2d());
+            assert_eq!(drawn.next_1d(), skipped.next_1d());
+            // A skipped number likewise (one PCG step, not two).
+            drawn.next_1d();
+            skipped.skip_1d();
             assert_eq!(drawn.next_2d(), skipped.next_2d());
             assert_eq!(drawn.next_1d(), skipped.next_1d());
         }

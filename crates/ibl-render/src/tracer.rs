@@ -601,7 +601,14 @@ impl<'a> Tracer<'a> {
             }
             // At the last vertex the reference still draws the BSDF sample: escaping, it is the
             // MIS partner of the environment sample.
-            let lobe = stream.next_1d();
+            // A diffuse or mirror BSDF has no lobe to choose: its number is skipped, not drawn
+            // (the same later numbers, one Sobol pair's hashing less per vertex).
+            let lobe = if bsdf.chooses_lobe() {
+                stream.next_1d()
+            } else {
+                stream.skip_1d();
+                0.0
+            };
             let [u1, u2] = stream.next_2d();
             let Some(sample) = bsdf.sample(wo, [lobe, u1, u2]) else {
                 break;
