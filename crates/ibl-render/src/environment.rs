@@ -212,7 +212,9 @@ impl EnvironmentLight {
         Self::build(probe, world_from_probe, radiance_scale, false)
     }
 
-    fn build(
+    /// [`EnvironmentLight::new`] when `with_normal_bins`, else
+    /// [`EnvironmentLight::without_normal_bins`].
+    pub(crate) fn build(
         probe: Image<Rgb>,
         world_from_probe: Mat3,
         radiance_scale: f32,

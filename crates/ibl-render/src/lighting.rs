@@ -409,12 +409,12 @@ impl Lighting {
     /// The environment of `scene`'s probe; with its normal bins only for the reference, whose
     /// surfaces draw environment samples ([`EnvironmentLight::without_normal_bins`]).
     fn environment(scene: &Scene, sampled: bool) -> Result<EnvironmentLight, EnvironmentError> {
-        let (probe, frame) = (scene.probe.radiance.clone(), scene.probe.world_from_probe);
-        if sampled {
-            EnvironmentLight::new(probe, frame, 1.0)
-        } else {
-            EnvironmentLight::without_normal_bins(probe, frame, 1.0)
-        }
+        EnvironmentLight::build(
+            scene.probe.radiance.clone(),
+            scene.probe.world_from_probe,
+            1.0,
+            sampled,
+        )
     }
 
     /// Reference lighting: the full probe.
