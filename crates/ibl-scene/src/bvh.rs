@@ -13,22 +13,31 @@
 //! 64-entry traversal stack cannot overflow. Subtrees of 2048 triangles or more are built in
 //! parallel (rayon); each subtree is a pure function of its triangles, so the result is
 //! identical for any thread count. Cost: O(n log n) for well-spread input (O(n) per level,
-//! O(log n) levels), at most O(64 n) whatever the input; memory 64 bytes per pair of sibling
-//! nodes plus 40 bytes per triangle.
+//! O(log n) levels), at most O(64 n) whatever the input; memory 128 bytes per four-wide node
+//! (about one per two binary inner nodes) plus 40 bytes per triangle.
 //!
-//! **Layout**: the two children of an inner node sit side by side in one 64-byte, cache-line
-//! aligned record with their boxes stored axis by axis (`(lo_0, lo_1, hi_0, hi_1)`), so one
-//! SIMD slab test checks both children. Triangles are stored in leaf order as their three
-//! corners (not edges: shared corners must stay bit-identical for the watertight test), with the
-//! input index beside them.
+//! **Layout** (a four-wide tree collapsed from the binary one, as in Wald et al. 2008, "Getting
+//! rid of packets", and Embree's BVH4): each node of the binary tree is replaced by its
+//! grandchildren where its children are inner nodes (its leaf children stay), and a node left
+//! with three children opens its widest inner one too, so every four-wide inner node lies at
+//! least two binary levels below its parent and a path has at most 31 of them. The (up to)
+//! four children of a node sit side by side in one 128-byte, cache-line aligned record with
+//! their boxes stored corner by corner and axis by axis (lane `i` is child `i`), so one SIMD
+//! slab test checks all four; an unused slot holds the empty box, which no ray enters. The
+//! leaves are the binary tree's, so queries answer exactly as before, and the walk visits
+//! about half as many nodes: on the bunny scenes' reference renders 4.6 to 4.9 % fewer
+//! instructions a path than the binary layout (cachegrind; BENCHMARKS.md, "A four-wide BVH").
+//! Triangles are stored in leaf order as their three corners (not edges: shared corners must
+//! stay bit-identical for the watertight test), with the input index beside them.
 //!
 //! **Ray-box** (Williams et al. 2005; Ize 2013, "Robust BVH ray traversal"): slabs with the
 //! precomputed inverse direction clamped to `+-f32::MAX`, so a zero direction component never
-//! produces `0 * inf = NaN`; per axis `min`/`max` of the two plane distances. Far distances and
-//! the best hit distance are widened by `2^-16` of their magnitude in every culling comparison:
-//! more than the rounding of the slab distances (Ize's `1 + 2 gamma_3`, flat boxes of
-//! axis-aligned triangles included) and of a triangle's `t`, so a box never culls a hit that the
-//! triangle test alone would report.
+//! produces `0 * inf = NaN`; per axis the near and far plane picked by the sign of the inverse
+//! direction (Williams' ordering: the same values as `min`/`max` of the two plane distances).
+//! Far distances and the best hit distance are widened by `2^-16` of their magnitude in every
+//! culling comparison: more than the rounding of the slab distances (Ize's `1 + 2 gamma_3`, flat
+//! boxes of axis-aligned triangles included) and of a triangle's `t`, so a box never culls a hit
+//! that the triangle test alone would report.
 //!
 //! **Ray-triangle** (Woop, Benthin & Wald 2013, "Watertight ray/triangle intersection", JCGT
 //! 2(1)): the corners are translated to the ray origin and sheared so that the ray becomes the
@@ -43,12 +52,15 @@
 //! surface's hit-point error bound can then never hit the surface again, however large the
 //! triangle, and `t_min = 0` is the right lower limit for such rays.
 //!
-//! **Traversal**: near child first with an explicit 64-entry stack (no allocation per query);
-//! popped subtrees farther than the best hit are skipped. Closest-hit ties (equal `t`) go to the
-//! smallest input index, so the answer is that of a brute-force loop over all triangles,
-//! whatever the tree or the order of traversal. Expected cost O(log n) per ray.
+//! **Traversal**: for closest hits the nearest child entered first, the others pushed farthest
+//! first with their entry distances on an explicit 93-entry stack (no allocation per query;
+//! three pushes per node on a path of at most 31); popped subtrees farther than the best hit
+//! are skipped. Shadow rays take the children in slot order: any blocker ends the walk.
+//! Closest-hit ties (equal `t`) go to the smallest input index, so the answer is that of a
+//! brute-force loop over all triangles, whatever the tree or the order of traversal. Expected
+//! cost O(log n) per ray.
 
-use glam::{Vec3, Vec3A, Vec4, Vec4Swizzles};
+use glam::{Vec3, Vec3A, Vec4};
 
 use crate::ray::{Hit, Ray, gamma};
 
@@ -59,8 +71,11 @@ const MAX_LEAF: usize = 4;
 /// Nodes at this depth (root 0) or deeper are split at the median only: the count halves at each
 /// of them, so fewer than 2^32 triangles end in leaves by depth 62.
 const SAH_MAX_DEPTH: usize = 32;
-/// Traversal stack entries: at least the number of inner nodes on the longest path (62).
-const STACK_SIZE: usize = 64;
+/// Nodes on the longest root-to-leaf path of the binary tree, at most (module notes).
+const MAX_DEPTH: usize = 63;
+/// Traversal stack entries: each four-wide inner node on a path pushes at most three children,
+/// and a path has at most half the binary tree's inner nodes (`MAX_DEPTH - 1`), rounded up.
+const STACK_SIZE: usize = 3 * (MAX_DEPTH - 1).div_ceil(2);
 /// Subtrees with at least this many triangles are built in parallel.
 const PARALLEL_MIN: usize = 2048;
 /// Relative widening of box far distances and of the best distance in culling comparisons.
@@ -69,9 +84,10 @@ const WIDEN: f32 = 1.0 / 65536.0;
 /// A bounding volume hierarchy over a triangle soup; see the module notes.
 #[derive(Clone, Debug, Default)]
 pub struct Bvh {
-    /// Sibling pairs in depth-first order; an inner node refers to the pair of its children.
-    pairs: Vec<NodePair>,
-    /// The root: a pair index (`count == 0`) or a leaf.
+    /// Inner nodes of the four-wide tree in depth-first order, each holding its (up to) four
+    /// children's boxes and references.
+    nodes: Vec<QuadNode>,
+    /// The root: a node index (`count == 0`) or a leaf.
     root: NodeRef,
     /// Bounds of all triangles.
     bounds: Option<(Vec3, Vec3)>,
@@ -79,38 +95,49 @@ pub struct Bvh {
     triangles: Vec<[f32; 9]>,
     /// Input index of each triangle, in leaf order.
     indices: Vec<u32>,
-    /// Nodes on the longest root-to-leaf path.
+    /// Nodes on the longest root-to-leaf path of the binary tree as built.
     depth: usize,
+    /// Inner nodes of the binary tree as built.
+    binary_inner: usize,
 }
 
-/// A node reference: `count == 0` means an inner node whose children are `pairs[child]`,
-/// otherwise a leaf of `count` triangles starting at `child` in leaf order.
+/// A node reference: `count == 0` means an inner node `nodes[child]`, otherwise a leaf of
+/// `count` triangles starting at `child` in leaf order.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 struct NodeRef {
     child: u32,
     count: u32,
 }
 
-/// Two sibling nodes, boxes stored per axis as `(lo_0, lo_1, hi_0, hi_1)`; one cache line.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+/// Up to four sibling nodes: `bounds[0]` their lower corners and `bounds[1]` their upper ones,
+/// each stored axis by axis (lane `i` of `bounds[s][axis]` is child `i`'s), so one SIMD slab
+/// test checks all four; two cache lines. An unused slot has the empty box (`lo = +inf`,
+/// `hi = -inf`), which the slab test never enters.
+#[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C, align(64))]
-struct NodePair {
-    x: Vec4,
-    y: Vec4,
-    z: Vec4,
-    child: [u32; 2],
-    count: [u32; 2],
+struct QuadNode {
+    bounds: [[Vec4; 3]; 2],
+    child: [u32; 4],
+    count: [u32; 4],
 }
 
-impl NodePair {
-    fn new(a: Aabb, b: Aabb, ra: NodeRef, rb: NodeRef) -> Self {
-        NodePair {
-            x: Vec4::new(a.lo.x, b.lo.x, a.hi.x, b.hi.x),
-            y: Vec4::new(a.lo.y, b.lo.y, a.hi.y, b.hi.y),
-            z: Vec4::new(a.lo.z, b.lo.z, a.hi.z, b.hi.z),
-            child: [ra.child, rb.child],
-            count: [ra.count, rb.count],
+impl QuadNode {
+    /// The node over `children` (one to four boxes with their references).
+    fn new(children: &[(Aabb, NodeRef)]) -> Self {
+        let mut node = QuadNode {
+            bounds: [[Vec4::INFINITY; 3], [Vec4::NEG_INFINITY; 3]],
+            child: [0; 4],
+            count: [0; 4],
+        };
+        for (i, (aabb, r)) in children.iter().enumerate() {
+            for axis in 0..3 {
+                node.bounds[0][axis][i] = aabb.lo[axis];
+                node.bounds[1][axis][i] = aabb.hi[axis];
+            }
+            node.child[i] = r.child;
+            node.count[i] = r.count;
         }
+        node
     }
 
     fn get(&self, i: usize) -> NodeRef {
@@ -236,11 +263,11 @@ impl Bvh {
         }
         let mut prims = prims(triangles);
         let tree = build(&mut prims, 0, 0);
-        let mut pairs = Vec::with_capacity(tree.inner);
-        let root = flatten(&tree.node, &mut pairs);
+        let mut nodes = Vec::with_capacity(tree.inner.div_ceil(2));
+        let root = flatten(&tree.node, &mut nodes);
         let all = tree.node.bounds();
         Bvh {
-            pairs,
+            nodes,
             root,
             bounds: Some((Vec3::from(all.lo), Vec3::from(all.hi))),
             triangles: prims
@@ -252,6 +279,7 @@ impl Bvh {
                 .collect(),
             indices: prims.iter().map(|p| p.index).collect(),
             depth: tree.depth,
+            binary_inner: tree.inner,
         }
     }
 
@@ -317,16 +345,19 @@ impl Bvh {
         corners
     }
 
-    /// Number of nodes, inner and leaves (0 when empty, 1 for a single leaf).
+    /// Number of nodes, inner and leaves, of the binary tree as built (0 when empty, 1 for a
+    /// single leaf); the four-wide tree that queries walk has the same leaves.
     pub fn node_count(&self) -> usize {
         if self.indices.is_empty() {
             0
         } else {
-            1 + 2 * self.pairs.len()
+            1 + 2 * self.binary_inner
         }
     }
 
-    /// Nodes on the longest root-to-leaf path (0 when empty, 1 for a single leaf; at most 63).
+    /// Nodes on the longest root-to-leaf path of the binary tree as built (0 when empty, 1 for
+    /// a single leaf; at most 63); the four-wide tree's paths have at most half as many inner
+    /// nodes.
     pub fn depth(&self) -> usize {
         self.depth
     }
@@ -360,37 +391,48 @@ impl Bvh {
             }
         };
         let mut node = self.root;
-        // Early outs before the traversal stack is made (zeroed, 1 KiB: it was 3 % of a
+        // Early outs before the traversal stack is made (zeroed, 1.1 KiB: it was 3 % of a
         // reference render): a root leaf (a ground plane's two triangles) is tested directly,
-        // and a ray that misses both of the root's children (most rays, past a small object)
+        // and a ray that misses all of the root's children (most rays, past a small object)
         // stops at once.
         let box_ray = (node.count == 0).then(|| BoxRay::new(ray, t_min));
         match &box_ray {
             None => test_leaf(node.child as usize, node.count as usize, &mut cull),
-            Some(box_ray) if box_ray.test(&self.pairs[node.child as usize], cull).0 != 0 => {
+            Some(box_ray) if box_ray.test(&self.nodes[node.child as usize], cull).0 != 0 => {
                 let mut stack = [(NodeRef::default(), 0.0f32); STACK_SIZE];
                 let mut sp = 0;
                 loop {
                     if node.count == 0 {
-                        let pair = &self.pairs[node.child as usize];
-                        let (mask, near) = box_ray.test(pair, cull);
+                        let quad = &self.nodes[node.child as usize];
+                        let (mask, near) = box_ray.test(quad, cull);
                         if mask == 0 {
                             if !pop(&stack, &mut sp, &mut node, cull) {
                                 break;
                             }
                             continue;
                         }
-                        // Branch-free: the only child hit, or the nearer of both with the
-                        // other pushed.
-                        let near = [near.x, near.y];
-                        let first = if mask == 3 {
-                            usize::from(near[1] < near[0])
-                        } else {
-                            (mask >> 1) as usize
-                        };
-                        stack[sp] = (pair.get(first ^ 1), near[first ^ 1]);
-                        sp += usize::from(mask == 3);
-                        node = pair.get(first);
+                        let rest = mask & (mask - 1);
+                        if rest == 0 {
+                            node = quad.get(mask.trailing_zeros() as usize);
+                            continue;
+                        }
+                        if rest & (rest - 1) == 0 {
+                            // Two: the nearer next, the other pushed.
+                            let (a, b) = (mask.trailing_zeros(), rest.trailing_zeros());
+                            let (a, b) = (a as usize, b as usize);
+                            let (next, later) = if near[b] < near[a] { (b, a) } else { (a, b) };
+                            stack[sp] = (quad.get(later), near[later]);
+                            sp += 1;
+                            node = quad.get(next);
+                            continue;
+                        }
+                        // The nearest child next, the others pushed farthest first.
+                        let (order, n) = far_to_near(mask, near);
+                        for &i in &order[..n - 1] {
+                            stack[sp] = (quad.get(i), near[i]);
+                            sp += 1;
+                        }
+                        node = quad.get(order[n - 1]);
                         continue;
                     }
                     test_leaf(node.child as usize, node.count as usize, &mut cull);
@@ -418,13 +460,13 @@ impl Bvh {
     ) -> bool {
         let cull = widen(t_max);
         let mut node = self.root;
-        // Early outs before the triangle ray and the traversal stack (zeroed, 512 bytes) are
-        // made: most shadow rays miss both of the root's children (the rays from a floor past a
+        // Early outs before the triangle ray and the traversal stack (zeroed, 768 bytes) are
+        // made: most shadow rays miss all of the root's children (the rays from a floor past a
         // small object), and a root leaf (a ground plane's two triangles) is tested directly,
         // without the box ray's divisions.
         let box_ray = (node.count == 0).then(|| BoxRay::new(ray, t_min));
         if let Some(box_ray) = &box_ray
-            && box_ray.test(&self.pairs[node.child as usize], cull).0 == 0
+            && box_ray.test(&self.nodes[node.child as usize], cull).0 == 0
         {
             return false;
         }
@@ -454,8 +496,8 @@ impl Bvh {
         let mut sp = 0;
         loop {
             if node.count == 0 {
-                let pair = &self.pairs[node.child as usize];
-                let (mask, near) = box_ray.test(pair, cull);
+                let quad = &self.nodes[node.child as usize];
+                let (mask, _) = box_ray.test(quad, cull);
                 if mask == 0 {
                     if sp == 0 {
                         return false;
@@ -464,14 +506,19 @@ impl Bvh {
                     node = stack[sp];
                     continue;
                 }
-                let first = if mask == 3 {
-                    usize::from(near.y < near.x)
-                } else {
-                    (mask >> 1) as usize
-                };
-                stack[sp] = pair.get(first ^ 1);
-                sp += usize::from(mask == 3);
-                node = pair.get(first);
+                if mask.is_power_of_two() {
+                    node = quad.get(mask.trailing_zeros() as usize);
+                    continue;
+                }
+                // The first child entered next, the others pushed: any blocker ends the walk,
+                // and ordering the children by distance cost more than it saved.
+                let mut rest = mask & (mask - 1);
+                node = quad.get(mask.trailing_zeros() as usize);
+                while rest != 0 {
+                    stack[sp] = quad.get(rest.trailing_zeros() as usize);
+                    sp += 1;
+                    rest &= rest - 1;
+                }
                 continue;
             }
             if blocked_in(node.child as usize, node.count as usize) {
@@ -661,25 +708,62 @@ fn partition(prims: &mut [Prim], split: Split, centroids: Aabb) -> usize {
     }
 }
 
-/// Writes the pairs below `node` depth first and returns its reference.
-fn flatten(node: &BuildNode, pairs: &mut Vec<NodePair>) -> NodeRef {
+/// Writes the four-wide nodes below `node` depth first and returns its reference.
+fn flatten(node: &BuildNode, nodes: &mut Vec<QuadNode>) -> NodeRef {
     match node {
         BuildNode::Leaf { first, count, .. } => NodeRef {
             child: *first,
             count: *count,
         },
-        BuildNode::Inner { children, .. } => {
-            let slot = pairs.len();
-            pairs.push(NodePair::default());
-            let a = flatten(&children[0], pairs);
-            let b = flatten(&children[1], pairs);
-            pairs[slot] = NodePair::new(children[0].bounds(), children[1].bounds(), a, b);
+        BuildNode::Inner { .. } => {
+            let slot = nodes.len();
+            nodes.push(QuadNode::new(&[]));
+            let children = quad_children(node);
+            let refs: Vec<(Aabb, NodeRef)> = children
+                .iter()
+                .map(|c| (c.bounds(), flatten(c, nodes)))
+                .collect();
+            nodes[slot] = QuadNode::new(&refs);
             NodeRef {
                 child: slot as u32,
                 count: 0,
             }
         }
     }
+}
+
+/// The children of inner binary node `node` in the four-wide tree: its grandchildren where its
+/// children are inner, the leaf children themselves; with three, the inner one of largest area
+/// is opened in turn (the first on ties). Every inner node of the four-wide tree therefore
+/// sits at least two binary levels below its parent, which bounds the traversal stack.
+fn quad_children(node: &BuildNode) -> Vec<&BuildNode> {
+    // An inner node's two children in place of it, a leaf itself.
+    fn open<'a>(n: &'a BuildNode, out: &mut Vec<&'a BuildNode>) {
+        match n {
+            BuildNode::Inner { children, .. } => out.extend(children.iter()),
+            BuildNode::Leaf { .. } => out.push(n),
+        }
+    }
+    let mut children = Vec::with_capacity(4);
+    if let BuildNode::Inner { children: two, .. } = node {
+        two.iter().for_each(|c| open(c, &mut children));
+    }
+    if children.len() == 3 {
+        let mut widest: Option<(usize, f32)> = None;
+        for (i, c) in children.iter().enumerate() {
+            let area = c.bounds().half_area();
+            if matches!(c, BuildNode::Inner { .. }) && widest.is_none_or(|(_, a)| area > a) {
+                widest = Some((i, area));
+            }
+        }
+        if let Some((i, _)) = widest {
+            let inner = children.remove(i);
+            let mut two = Vec::with_capacity(2);
+            open(inner, &mut two);
+            children.splice(i..i, two);
+        }
+    }
+    children
 }
 
 /// Pops the next stack entry not farther than `cull` into `node`; false when none is left.
@@ -712,10 +796,13 @@ fn dominant_axis(d: Vec3) -> usize {
     }
 }
 
-/// A ray prepared for slab tests against node pairs.
+/// A ray prepared for slab tests against four-wide nodes.
 struct BoxRay {
     origin: [Vec4; 3],
     inv_dir: [Vec4; 3],
+    /// Per axis, which of a node's corners (0: lower, 1: upper) the ray meets first: the lower
+    /// one where the direction component is positive (or +0).
+    near_side: [usize; 3],
     t_min: Vec4,
 }
 
@@ -725,33 +812,61 @@ impl BoxRay {
         // 1/0 = inf would give 0 * inf = NaN on a slab plane through the origin; a finite
         // `f32::MAX` gives 0 there and +-inf (never NaN) elsewhere.
         let inv = (Vec3::ONE / ray.direction).clamp(Vec3::splat(-f32::MAX), Vec3::splat(f32::MAX));
+        let side = |v: f32| usize::from(v.is_sign_negative());
         BoxRay {
             origin: [Vec4::splat(o.x), Vec4::splat(o.y), Vec4::splat(o.z)],
             inv_dir: [Vec4::splat(inv.x), Vec4::splat(inv.y), Vec4::splat(inv.z)],
+            near_side: [side(inv.x), side(inv.y), side(inv.z)],
             t_min: Vec4::splat(t_min),
         }
     }
 
-    /// Which of the two children the ray enters within `[t_min, t_hi]` (bit 0: child 0, bit 1:
-    /// child 1) and their entry distances in lanes x and y.
+    /// Which of the four children the ray enters within `[t_min, t_hi]` (bit `i`: child `i`)
+    /// and their entry distances, lane by lane. Per axis the near plane's distance is the
+    /// smaller of the two (the inverse direction's sign orders them), so the values are those
+    /// of `min`/`max` over both planes; an empty box's near distance is `+inf` and its far
+    /// one `-inf` on every axis, never entered.
     #[inline(always)]
-    fn test(&self, pair: &NodePair, t_hi: f32) -> (u32, Vec4) {
-        let tx = (pair.x - self.origin[0]) * self.inv_dir[0];
-        let ty = (pair.y - self.origin[1]) * self.inv_dir[1];
-        let tz = (pair.z - self.origin[2]) * self.inv_dir[2];
-        let (sx, sy, sz) = (tx.zwxy(), ty.zwxy(), tz.zwxy());
-        let near = tx.min(sx).max(ty.min(sy)).max(tz.min(sz)).max(self.t_min);
+    fn test(&self, node: &QuadNode, t_hi: f32) -> (u32, Vec4) {
+        let slab = |axis: usize| {
+            let s = self.near_side[axis];
+            let near = (node.bounds[s][axis] - self.origin[axis]) * self.inv_dir[axis];
+            let far = (node.bounds[1 - s][axis] - self.origin[axis]) * self.inv_dir[axis];
+            (near, far)
+        };
+        let (nx, fx) = slab(0);
+        let (ny, fy) = slab(1);
+        let (nz, fz) = slab(2);
+        let near = nx.max(ny).max(nz).max(self.t_min);
         // A zero direction component gives `far = -inf` for a slab the ray runs beside; widening
         // that would make `-inf + inf = NaN`, which `min` turns into `t_hi`, so the node would
         // never be culled. Finite values are unchanged.
-        let far = tx
-            .max(sx)
-            .min(ty.max(sy))
-            .min(tz.max(sz))
-            .max(Vec4::splat(-f32::MAX));
+        let far = fx.min(fy).min(fz).max(Vec4::splat(-f32::MAX));
         let far = (far + far.abs() * WIDEN).min(Vec4::splat(t_hi));
-        (near.cmple(far).bitmask() & 3, near)
+        (near.cmple(far).bitmask(), near)
     }
+}
+
+/// The children set in `mask` (bit `i`: child `i`), farthest first by their entry distance
+/// `near` (ties by child order), and how many there are.
+#[inline(always)]
+fn far_to_near(mask: u32, near: Vec4) -> ([usize; 4], usize) {
+    let mut order = [0usize; 4];
+    let mut n = 0;
+    for i in 0..4 {
+        if mask >> i & 1 == 1 {
+            order[n] = i;
+            n += 1;
+        }
+    }
+    for a in 1..n {
+        let mut b = a;
+        while b > 0 && near[order[b - 1]] < near[order[b]] {
+            order.swap(b - 1, b);
+            b -= 1;
+        }
+    }
+    (order, n)
 }
 
 /// A ray prepared for the watertight triangle test: `k_z = KZ` is the dominant axis, the shear
@@ -855,9 +970,47 @@ mod tests {
     }
 
     #[test]
-    fn node_pair_is_one_cache_line() {
-        assert_eq!(std::mem::size_of::<NodePair>(), 64);
-        assert_eq!(std::mem::align_of::<NodePair>(), 64);
+    fn quad_node_is_two_cache_lines() {
+        assert_eq!(std::mem::size_of::<QuadNode>(), 128);
+        assert_eq!(std::mem::align_of::<QuadNode>(), 64);
+    }
+
+    /// Four-wide inner nodes on the longest path from `r` down.
+    fn quad_depth(bvh: &Bvh, r: NodeRef) -> usize {
+        if r.count > 0 {
+            return 0;
+        }
+        let q = &bvh.nodes[r.child as usize];
+        1 + (0..4)
+            .filter(|&i| q.count[i] > 0 || q.child[i] > r.child)
+            .map(|i| quad_depth(bvh, q.get(i)))
+            .max()
+            .unwrap_or(0)
+    }
+
+    #[test]
+    fn four_wide_paths_have_at_most_half_the_binary_inner_nodes() {
+        // Well-spread triangles, and the deep SAH tree of exponentially spaced ones.
+        let deep: Vec<[Vec3; 3]> = (0..120)
+            .map(|i| {
+                let x = 2f32.powi(i);
+                [
+                    Vec3::new(x, 0.0, 0.0),
+                    Vec3::new(x, 1.0, 0.0),
+                    Vec3::new(x, 0.0, 1.0),
+                ]
+            })
+            .collect();
+        for tris in [soup(5000, 2), deep] {
+            let bvh = Bvh::new(&tris);
+            let quads = quad_depth(&bvh, bvh.root);
+            assert!(
+                quads >= 1 && quads <= (bvh.depth() - 1).div_ceil(2),
+                "{quads} {}",
+                bvh.depth()
+            );
+            assert!(3 * quads <= STACK_SIZE);
+        }
     }
 
     #[test]
@@ -871,7 +1024,7 @@ mod tests {
                 .install(|| Bvh::new(&tris))
         };
         let (one, many) = (with(1), with(4));
-        assert_eq!(one.pairs, many.pairs);
+        assert_eq!(one.nodes, many.nodes);
         assert_eq!(one.root, many.root);
         assert_eq!(one.indices, many.indices);
         assert_eq!(one.triangles, many.triangles);
@@ -895,13 +1048,16 @@ mod tests {
         let mut leaves = Vec::new();
         while let Some(r) = stack.pop() {
             if r.count == 0 {
-                let p = &bvh.pairs[r.child as usize];
-                stack.push(p.get(1));
-                stack.push(p.get(0));
+                let q = &bvh.nodes[r.child as usize];
+                let used = (0..4).filter(|&i| q.bounds[0][0][i] <= q.bounds[1][0][i]);
+                let children: Vec<NodeRef> = used.map(|i| q.get(i)).collect();
+                assert!((2..=4).contains(&children.len()));
+                stack.extend(children.into_iter().rev());
             } else {
                 leaves.push(r);
             }
         }
+        let leaf_count = leaves.len();
         for r in leaves {
             assert!((1..=MAX_LEAF as u32).contains(&r.count));
             assert_eq!(
@@ -914,7 +1070,7 @@ mod tests {
             }
         }
         assert!(seen.iter().all(|&s| s));
-        assert_eq!(bvh.node_count(), 2 * bvh.pairs.len() + 1);
+        assert_eq!(bvh.node_count(), 2 * (leaf_count - 1) + 1);
     }
 
     #[test]
@@ -932,12 +1088,17 @@ mod tests {
                 }
                 return;
             }
-            let p = &bvh.pairs[r.child as usize];
-            for i in 0..2 {
-                let clo = Vec3::new(p.x[i], p.y[i], p.z[i]);
-                let chi = Vec3::new(p.x[2 + i], p.y[2 + i], p.z[2 + i]);
+            let q = &bvh.nodes[r.child as usize];
+            for i in 0..4 {
+                let [x, y, z] = q.bounds[0];
+                let clo = Vec3::new(x[i], y[i], z[i]);
+                let [x, y, z] = q.bounds[1];
+                let chi = Vec3::new(x[i], y[i], z[i]);
+                if clo.x > chi.x {
+                    continue; // an unused slot
+                }
                 assert!(clo.cmpge(lo).all() && chi.cmple(hi).all());
-                check(bvh, p.get(i), clo, chi);
+                check(bvh, q.get(i), clo, chi);
             }
         }
         let (lo, hi) = bvh.bounds().unwrap();
@@ -960,7 +1121,7 @@ mod tests {
             .collect();
         let bvh = Bvh::new(&tris);
         assert!(bvh.depth() > 20, "the SAH goes deep here: {}", bvh.depth());
-        assert!(bvh.depth() < STACK_SIZE, "depth {}", bvh.depth());
+        assert!(bvh.depth() <= MAX_DEPTH, "depth {}", bvh.depth());
         // Every triangle is still found: rays along +X at y = z = 0.25 hit the next one ahead.
         for i in [0, 1, 60, 119] {
             let x = if i == 0 { 0.0 } else { 2f32.powi(i) * 0.75 };
@@ -983,7 +1144,7 @@ mod tests {
             n = n.div_ceil(2);
             depth += 1;
         }
-        assert!(depth < STACK_SIZE, "deepest leaf at depth {depth}");
+        assert!(depth < MAX_DEPTH, "deepest leaf at depth {depth}");
     }
 
     #[test]
@@ -998,18 +1159,18 @@ mod tests {
             lo: Vec3A::splat(5.0),
             hi: Vec3A::splat(6.0),
         };
-        let pair = NodePair::new(a, b, NodeRef::default(), NodeRef::default());
+        let quad = QuadNode::new(&[(a, NodeRef::default()), (b, NodeRef::default())]);
         for origin in [Vec3::new(0.0, 0.5, 3.0), Vec3::new(0.0, 0.0, 3.0)] {
             let ray = BoxRay::new(&Ray::new(origin, Vec3::NEG_Z), 0.0);
-            let (mask, near) = ray.test(&pair, f32::INFINITY);
-            assert_eq!(mask, 1);
+            let (mask, near) = ray.test(&quad, f32::INFINITY);
+            assert_eq!(mask, 1, "the two unused slots are never entered");
             assert!((near.x - 2.0).abs() < 1e-6, "{near}");
         }
         // Beside the slab with a zero component: a miss, not NaN. Far beside it on the negative
         // side both plane distances overflow to -inf (the case that must not widen to NaN).
         for x in [-0.1, 1.1, 2.5, 300.0] {
             let ray = BoxRay::new(&Ray::new(Vec3::new(x, 0.5, 3.0), Vec3::NEG_Z), 0.0);
-            assert_eq!(ray.test(&pair, f32::INFINITY).0, 0, "x = {x}");
+            assert_eq!(ray.test(&quad, f32::INFINITY).0, 0, "x = {x}");
         }
     }
 
