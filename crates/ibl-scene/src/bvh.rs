@@ -975,23 +975,10 @@ mod tests {
         assert_eq!(std::mem::align_of::<QuadNode>(), 64);
     }
 
-    /// Four-wide inner nodes on the longest path from `r` down.
-    fn quad_depth(bvh: &Bvh, r: NodeRef) -> usize {
-        if r.count > 0 {
-            return 0;
-        }
-        let q = &bvh.nodes[r.child as usize];
-        1 + (0..4)
-            .filter(|&i| q.count[i] > 0 || q.child[i] > r.child)
-            .map(|i| quad_depth(bvh, q.get(i)))
-            .max()
-            .unwrap_or(0)
-    }
-
-    #[test]
-    fn four_wide_paths_have_at_most_half_the_binary_inner_nodes() {
-        // Well-spread triangles, and the deep SAH tree of exponentially spaced ones.
-        let deep: Vec<[Vec3; 3]> = (0..120)
+    /// 120 triangles, each twice as far along +X as the previous one: the SAH peels a few off
+    /// per level, far deeper than log2(n).
+    fn exponentially_spaced() -> Vec<[Vec3; 3]> {
+        (0..120)
             .map(|i| {
                 let x = 2f32.powi(i);
                 [
@@ -1000,8 +987,30 @@ mod tests {
                     Vec3::new(x, 0.0, 1.0),
                 ]
             })
-            .collect();
-        for tris in [soup(5000, 2), deep] {
+            .collect()
+    }
+
+    /// The slots of `q` that hold a child (an unused one has the empty box).
+    fn used_slots(q: &QuadNode) -> impl Iterator<Item = usize> + '_ {
+        (0..4).filter(|&i| q.bounds[0][0][i] <= q.bounds[1][0][i])
+    }
+
+    /// Four-wide inner nodes on the longest path from `r` down.
+    fn quad_depth(bvh: &Bvh, r: NodeRef) -> usize {
+        if r.count > 0 {
+            return 0;
+        }
+        let q = &bvh.nodes[r.child as usize];
+        1 + used_slots(q)
+            .map(|i| quad_depth(bvh, q.get(i)))
+            .max()
+            .unwrap_or(0)
+    }
+
+    #[test]
+    fn four_wide_paths_have_at_most_half_the_binary_inner_nodes() {
+        // Well-spread triangles, and the deep SAH tree of exponentially spaced ones.
+        for tris in [soup(5000, 2), exponentially_spaced()] {
             let bvh = Bvh::new(&tris);
             let quads = quad_depth(&bvh, bvh.root);
             assert!(
@@ -1049,8 +1058,7 @@ mod tests {
         while let Some(r) = stack.pop() {
             if r.count == 0 {
                 let q = &bvh.nodes[r.child as usize];
-                let used = (0..4).filter(|&i| q.bounds[0][0][i] <= q.bounds[1][0][i]);
-                let children: Vec<NodeRef> = used.map(|i| q.get(i)).collect();
+                let children: Vec<NodeRef> = used_slots(q).map(|i| q.get(i)).collect();
                 assert!((2..=4).contains(&children.len()));
                 stack.extend(children.into_iter().rev());
             } else {
@@ -1089,14 +1097,11 @@ mod tests {
                 return;
             }
             let q = &bvh.nodes[r.child as usize];
-            for i in 0..4 {
+            for i in used_slots(q) {
                 let [x, y, z] = q.bounds[0];
                 let clo = Vec3::new(x[i], y[i], z[i]);
                 let [x, y, z] = q.bounds[1];
                 let chi = Vec3::new(x[i], y[i], z[i]);
-                if clo.x > chi.x {
-                    continue; // an unused slot
-                }
                 assert!(clo.cmpge(lo).all() && chi.cmple(hi).all());
                 check(bvh, q.get(i), clo, chi);
             }
@@ -1107,18 +1112,7 @@ mod tests {
 
     #[test]
     fn sah_depth_stays_bounded_on_exponentially_spaced_triangles() {
-        // Each triangle is twice as far along +X as the previous one: the SAH peels a few off
-        // per level, far deeper than log2(n).
-        let tris: Vec<[Vec3; 3]> = (0..120)
-            .map(|i| {
-                let x = 2f32.powi(i);
-                [
-                    Vec3::new(x, 0.0, 0.0),
-                    Vec3::new(x, 1.0, 0.0),
-                    Vec3::new(x, 0.0, 1.0),
-                ]
-            })
-            .collect();
+        let tris = exponentially_spaced();
         let bvh = Bvh::new(&tris);
         assert!(bvh.depth() > 20, "the SAH goes deep here: {}", bvh.depth());
         assert!(bvh.depth() <= MAX_DEPTH, "depth {}", bvh.depth());
