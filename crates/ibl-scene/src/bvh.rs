@@ -10,7 +10,7 @@
 //! from depth 32 on, the node is split at the median centroid along its widest centroid axis
 //! (ties by triangle index), which halves it: every root-to-leaf path therefore has at most 63
 //! nodes whatever the input (10000 identical triangles give a balanced tree), and the fixed
-//! 64-entry traversal stack cannot overflow. Subtrees of 2048 triangles or more are built in
+//! 93-entry traversal stack of the four-wide walk cannot overflow ("Traversal"). Subtrees of 2048 triangles or more are built in
 //! parallel (rayon); each subtree is a pure function of its triangles, so the result is
 //! identical for any thread count. Cost: O(n log n) for well-spread input (O(n) per level,
 //! O(log n) levels), at most O(64 n) whatever the input; memory 128 bytes per four-wide node
@@ -506,12 +506,8 @@ impl Bvh {
                     node = stack[sp];
                     continue;
                 }
-                if mask.is_power_of_two() {
-                    node = quad.get(mask.trailing_zeros() as usize);
-                    continue;
-                }
-                // The first child entered next, the others pushed: any blocker ends the walk,
-                // and ordering the children by distance cost more than it saved.
+                // The first child entered next, the others (if any) pushed: any blocker ends
+                // the walk, and ordering the children by distance cost more than it saved.
                 let mut rest = mask & (mask - 1);
                 node = quad.get(mask.trailing_zeros() as usize);
                 while rest != 0 {
@@ -756,11 +752,10 @@ fn quad_children(node: &BuildNode) -> Vec<&BuildNode> {
                 widest = Some((i, area));
             }
         }
-        if let Some((i, _)) = widest {
-            let inner = children.remove(i);
-            let mut two = Vec::with_capacity(2);
-            open(inner, &mut two);
-            children.splice(i..i, two);
+        if let Some((i, _)) = widest
+            && let BuildNode::Inner { children: two, .. } = children.remove(i)
+        {
+            children.splice(i..i, two.iter());
         }
     }
     children
