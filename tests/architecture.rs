@@ -9,6 +9,8 @@
 //!    re-exported name resolved to the module that defines it; the crate root's `pub use` lines
 //!    are its facade, not edges.
 //! 3. The command line tool stays thin: `src/` under 2,500 lines.
+//! 4. The Python wheel's build resolves its dependencies' features as the workspace does (CI reuses
+//!    the tests' artifacts for it).
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -499,4 +501,60 @@ fn the_command_line_tool_stays_thin() {
     }
     let n = lines(&repo().join("src"));
     assert!(n < 2500, "src/ has {n} lines; move jobs into ibl-pipeline");
+}
+
+/// `package version -> the feature sets cargo resolves for it`, from `cargo tree` with `args`
+/// (the host platform's dependencies).
+fn resolved_features(args: &[&str]) -> BTreeMap<String, BTreeSet<String>> {
+    let out = Command::new(env!("CARGO"))
+        .args([
+            "tree", "--locked", "--prefix", "none", "--format", "{p}|{f}",
+        ])
+        .args(args)
+        .current_dir(repo())
+        .output()
+        .expect("cargo tree runs");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let mut resolved: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
+    for line in String::from_utf8_lossy(&out.stdout).lines() {
+        let Some((package, features)) = line.trim_end_matches(" (*)").split_once('|') else {
+            continue;
+        };
+        // "name vX.Y.Z (path)" -> "name vX.Y.Z".
+        let package = package.split(' ').take(2).collect::<Vec<_>>().join(" ");
+        resolved
+            .entry(package)
+            .or_default()
+            .insert(features.to_string());
+    }
+    resolved
+}
+
+/// 4. CI builds the Python wheel (`maturin`, which builds `ibl-py` alone) after the Rust tests
+///    and reuses their artifacts only where cargo resolves each shared crate with the features
+///    the workspace's build gave it (crates/ibl-py/Cargo.toml, "The feature union";
+///    BENCHMARKS.md, "CI"): a new dependency that breaks that costs CI minutes, not a failure,
+///    so it is caught here.
+#[test]
+fn the_wheel_resolves_the_workspaces_features() {
+    let wheel = resolved_features(&["-p", "ibl-py", "-e", "normal,build"]);
+    let workspace = resolved_features(&["--workspace", "-e", "normal,build,dev"]);
+    let missing: Vec<String> = wheel
+        .iter()
+        .filter_map(|(package, sets)| {
+            let built = workspace.get(package)?;
+            let unmatched: Vec<&String> = sets.difference(built).collect();
+            (!unmatched.is_empty())
+                .then(|| format!("{package}: {unmatched:?}, the workspace builds {built:?}"))
+        })
+        .collect();
+    assert!(
+        missing.is_empty(),
+        "ask crates/ibl-py/Cargo.toml for the workspace's features of:\n{}",
+        missing.join("\n")
+    );
 }
