@@ -20,25 +20,33 @@ fn repo() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
-/// `crate name -> workspace crates it depends on` from `cargo metadata`.
-fn manifest_graph() -> BTreeMap<String, BTreeSet<String>> {
+/// The standard output of `cargo ARGS` run in the repository (the test fails with cargo's
+/// error when it does).
+fn cargo(args: &[&str]) -> Vec<u8> {
     let out = Command::new(env!("CARGO"))
-        .args([
-            "metadata",
-            "--format-version",
-            "1",
-            "--no-deps",
-            "--offline",
-        ])
+        .args(args)
         .current_dir(repo())
         .output()
-        .expect("cargo metadata runs");
+        .expect("cargo runs");
     assert!(
         out.status.success(),
-        "{}",
+        "cargo {}: {}",
+        args.join(" "),
         String::from_utf8_lossy(&out.stderr)
     );
-    let meta: serde_json::Value = serde_json::from_slice(&out.stdout).expect("metadata JSON");
+    out.stdout
+}
+
+/// `crate name -> workspace crates it depends on` from `cargo metadata`.
+fn manifest_graph() -> BTreeMap<String, BTreeSet<String>> {
+    let out = cargo(&[
+        "metadata",
+        "--format-version",
+        "1",
+        "--no-deps",
+        "--offline",
+    ]);
+    let meta: serde_json::Value = serde_json::from_slice(&out).expect("metadata JSON");
     let packages = meta["packages"].as_array().expect("packages");
     let names: BTreeSet<String> = packages
         .iter()
@@ -506,21 +514,12 @@ fn the_command_line_tool_stays_thin() {
 /// `package version -> the feature sets cargo resolves for it`, from `cargo tree` with `args`
 /// (the host platform's dependencies).
 fn resolved_features(args: &[&str]) -> BTreeMap<String, BTreeSet<String>> {
-    let out = Command::new(env!("CARGO"))
-        .args([
-            "tree", "--locked", "--prefix", "none", "--format", "{p}|{f}",
-        ])
-        .args(args)
-        .current_dir(repo())
-        .output()
-        .expect("cargo tree runs");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let tree = [
+        "tree", "--locked", "--prefix", "none", "--format", "{p}|{f}",
+    ];
+    let out = cargo(&[&tree[..], args].concat());
     let mut resolved: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
-    for line in String::from_utf8_lossy(&out.stdout).lines() {
+    for line in String::from_utf8_lossy(&out).lines() {
         let Some((package, features)) = line.trim_end_matches(" (*)").split_once('|') else {
             continue;
         };

@@ -10,9 +10,9 @@
 //! from depth 32 on, the node is split at the median centroid along its widest centroid axis
 //! (ties by triangle index), which halves it: every root-to-leaf path therefore has at most 63
 //! nodes whatever the input (10000 identical triangles give a balanced tree), and the fixed
-//! 93-entry traversal stack of the four-wide walk cannot overflow ("Traversal"). Subtrees of 2048 triangles or more are built in
-//! parallel (rayon); each subtree is a pure function of its triangles, so the result is
-//! identical for any thread count. Cost: O(n log n) for well-spread input (O(n) per level,
+//! 93-entry traversal stack of the four-wide walk cannot overflow ("Traversal"). Subtrees of
+//! 2048 triangles or more are built in parallel (rayon); each subtree is a pure function of its
+//! triangles, so the result is identical for any thread count. Cost: O(n log n) for well-spread input (O(n) per level,
 //! O(log n) levels), at most O(64 n) whatever the input; memory 128 bytes per four-wide node
 //! (about one per two binary inner nodes) plus 40 bytes per triangle.
 //!
