@@ -155,10 +155,19 @@ fn shuffled_rev_index(index_rev: u32, seed: u32) -> u32 {
     owen_scramble_rev(index_rev, hash(seed ^ SHUFFLE_KEY))
 }
 
-/// A reversed-bit Sobol coordinate Owen-scrambled by `key`, as a number in `[0, 1)`.
+/// Two reversed-bit Sobol coordinates Owen-scrambled by `keys`, as numbers in `[0, 1)`. Both
+/// are turned back by one 64-bit reversal (`reverse(a : b) = reverse(b) : reverse(a)`): the
+/// same bits as two 32-bit ones at half the shifts and masks (the x86-64 baseline has no
+/// bit-reversal instruction), which the pairs of every path draw several times.
 #[inline]
-fn scrambled(sobol_rev: u32, key: u32) -> f32 {
-    u32_to_f32_norm(owen_scramble_rev(sobol_rev, hash(key)).reverse_bits())
+fn scrambled(sobol_rev: [u32; 2], keys: [u32; 2]) -> [f32; 2] {
+    let a = owen_scramble_rev(sobol_rev[0], hash(keys[0]));
+    let b = owen_scramble_rev(sobol_rev[1], hash(keys[1]));
+    let both = ((u64::from(a) << 32) | u64::from(b)).reverse_bits();
+    [
+        u32_to_f32_norm(both as u32),
+        u32_to_f32_norm((both >> 32) as u32),
+    ]
 }
 
 /// Dimensions 0 and 1 of the Sobol sequence by look-up: entry `[d][0][b]` is the reversed-bit
@@ -199,10 +208,10 @@ impl SobolTables {
     fn point(&self, index_rev: u32, seed: u32) -> [f32; 2] {
         let rev = shuffled_rev_index(index_rev, seed);
         let base = seed.wrapping_mul(SEED_MULTIPLIER);
-        [
-            scrambled(self.get(0, rev), base ^ DIMENSION_KEYS[0]),
-            scrambled(self.get(1, rev), base ^ DIMENSION_KEYS[1]),
-        ]
+        scrambled(
+            [self.get(0, rev), self.get(1, rev)],
+            [base ^ DIMENSION_KEYS[0], base ^ DIMENSION_KEYS[1]],
+        )
     }
 }
 

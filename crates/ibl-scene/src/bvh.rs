@@ -368,11 +368,22 @@ impl Bvh {
         t_min: f32,
         t_max: f32,
     ) -> Option<Hit> {
-        let tri_ray = TriangleRay::<KX, KY, KZ>::new(ray);
         let mut best_t = t_max;
         let mut best: Option<(usize, TriangleHit)> = None;
         let mut best_index = u32::MAX;
         let mut cull = widen(best_t);
+        let mut node = self.root;
+        // Early outs before the triangle ray and the traversal stack (zeroed, 1.1 KiB: it was 3 %
+        // of a reference render) are made: a root leaf (a ground plane's two triangles) is tested
+        // directly, and a ray that misses all of the root's children (most rays, past a small
+        // object) stops at once.
+        let box_ray = (node.count == 0).then(|| BoxRay::new(ray, t_min));
+        if let Some(box_ray) = &box_ray
+            && box_ray.test(&self.nodes[node.child as usize], cull).0 == 0
+        {
+            return None;
+        }
+        let tri_ray = TriangleRay::<KX, KY, KZ>::new(ray);
         // The leaf `first..first + count` against the best hit so far.
         let mut test_leaf = |first: usize, count: usize, cull: &mut f32| {
             for k in first..first + count {
@@ -390,15 +401,9 @@ impl Bvh {
                 }
             }
         };
-        let mut node = self.root;
-        // Early outs before the traversal stack is made (zeroed, 1.1 KiB: it was 3 % of a
-        // reference render): a root leaf (a ground plane's two triangles) is tested directly,
-        // and a ray that misses all of the root's children (most rays, past a small object)
-        // stops at once.
-        let box_ray = (node.count == 0).then(|| BoxRay::new(ray, t_min));
         match &box_ray {
             None => test_leaf(node.child as usize, node.count as usize, &mut cull),
-            Some(box_ray) if box_ray.test(&self.nodes[node.child as usize], cull).0 != 0 => {
+            Some(box_ray) => {
                 let mut stack = [(NodeRef::default(), 0.0f32); STACK_SIZE];
                 let mut sp = 0;
                 loop {
@@ -441,7 +446,6 @@ impl Bvh {
                     }
                 }
             }
-            Some(_) => {}
         }
         best.map(|(k, h)| Hit {
             t: h.t,
