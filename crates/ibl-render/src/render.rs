@@ -466,17 +466,17 @@ impl PixelSampler<'_> {
     ) {
         let (tracer, settings) = (self.tracer, self.settings);
         let index = (y as u64) * u64::from(self.width) + x as u64;
-        // The stream of sample `s`, and the same stream after its pixel jitter (the pass without
-        // the objects draws exactly the numbers the pass with them drew).
-        let stream = |s: u32| SampleStream::new(settings.sampler, settings.seed, index, s);
-        let after_jitter = |s: u32| {
-            let mut stream = stream(s);
-            stream.next_2d();
-            stream
+        // One stream for the pixel, restarted at each sample (it keeps the pixel's pair keys,
+        // [`SampleStream::restart`]); a pass without the objects restarts it after the pixel
+        // jitter, so it draws exactly the numbers the pass with them drew.
+        let mut rng = SampleStream::new(settings.sampler, settings.seed, index, samples.start);
+        let after_jitter = |rng: &mut SampleStream, s: u32| {
+            rng.restart(s);
+            rng.skip_2d();
         };
         for s in samples {
             sums.samples += 1;
-            let mut rng = stream(s);
+            rng.restart(s);
             let [jx, jy] = rng.next_2d();
             let ray = self
                 .scene
@@ -501,7 +501,10 @@ impl PixelSampler<'_> {
                     let without = tracer.trace(
                         ray,
                         Layers::RealOnly,
-                        &mut after_jitter(s),
+                        {
+                            after_jitter(&mut rng, s);
+                            &mut rng
+                        },
                         hints,
                         &KnownVisibility::NONE,
                     );
@@ -522,7 +525,10 @@ impl PixelSampler<'_> {
                                 let again = tracer.trace(
                                     ray,
                                     Layers::RealOnly,
-                                    &mut after_jitter(s),
+                                    {
+                                        after_jitter(&mut rng, s);
+                                        &mut rng
+                                    },
                                     hints,
                                     &KnownVisibility::NONE,
                                 );
