@@ -466,10 +466,16 @@ impl PixelSampler<'_> {
     ) {
         let (tracer, settings) = (self.tracer, self.settings);
         let index = (y as u64) * u64::from(self.width) + x as u64;
-        // One stream for the pixel, restarted at each sample (it keeps the pixel's pair keys,
-        // [`SampleStream::restart`]); a pass without the objects restarts it after the pixel
-        // jitter, so it draws exactly the numbers the pass with them drew.
-        let mut rng = SampleStream::new(settings.sampler, settings.seed, index, samples.start);
+        // One stream for the pixel, restarted at each sample (it keeps the pixel's pair keys
+        // where there are several samples, [`SampleStream::keeping_keys`]); a pass without the
+        // objects restarts it after the pixel jitter, so it draws exactly the numbers the pass
+        // with them drew.
+        let (kind, seed, start) = (settings.sampler, settings.seed, samples.start);
+        let mut rng = if samples.len() > 1 {
+            SampleStream::keeping_keys(kind, seed, index, start)
+        } else {
+            SampleStream::new(kind, seed, index, start)
+        };
         let after_jitter = |rng: &mut SampleStream, s: u32| {
             rng.restart(s);
             rng.skip_2d();

@@ -65,8 +65,9 @@ pub struct SobolStream {
     pair: u64,
     /// The Sobol tables, looked up once per stream (not once per pair).
     tables: &'static SobolTables,
-    /// The keys of the pixel's first pairs, as far as they have been drawn.
-    kept: Box<KeptKeys>,
+    /// The keys of the pixel's first pairs, as far as they have been drawn, when the stream
+    /// keeps them ([`SampleStream::keeping_keys`]).
+    kept: Option<Box<KeptKeys>>,
 }
 
 /// The keys of a pixel's first [`KEPT_PAIRS`] pairs, each made when first drawn: bit `k` of
@@ -79,9 +80,10 @@ struct KeptKeys {
 
 /// What scrambles one pair, hashed from its seed: the key of the index shuffle and those of
 /// the two coordinates' digit scrambles. They depend on `(seed, pixel, pair)` and not on the
-/// sample, so a pixel's samples share them: a stream moved on to the pixel's next sample
-/// ([`SampleStream::restart`]) keeps them, which spares three of a pair's four hashes in every
-/// sample after the first (a tenth of a reference render's instructions were the pairs').
+/// sample, so a pixel's samples share them: a stream that keeps them
+/// ([`SampleStream::keeping_keys`]), moved on to the pixel's next sample
+/// ([`SampleStream::restart`]), spares three of a pair's four hashes in every sample after the
+/// first (a tenth of a reference render's instructions were the pairs').
 #[derive(Clone, Copy, Debug, Default)]
 struct PairKeys {
     shuffle: u32,
@@ -112,10 +114,18 @@ impl SobolStream {
             pixel_key: splitmix64(seed ^ splitmix64(pixel ^ 0x243f_6a88_85a3_08d3)),
             pair: 0,
             tables: LazyLock::force(&TABLES),
-            kept: Box::new(KeptKeys {
+            kept: None,
+        }
+    }
+
+    /// [`SobolStream::new`], keeping the pixel's pair keys as it makes them.
+    fn keeping_keys(seed: u64, pixel: u64, sample: u32) -> Self {
+        SobolStream {
+            kept: Some(Box::new(KeptKeys {
                 made: 0,
                 keys: [PairKeys::default(); KEPT_PAIRS],
-            }),
+            })),
+            ..SobolStream::new(seed, pixel, sample)
         }
     }
 
@@ -125,26 +135,33 @@ impl SobolStream {
         self.pair = 0;
     }
 
-    /// The seed of pair `pair`.
-    #[inline]
-    fn seed(&self, pair: u64) -> u32 {
-        splitmix64(self.pixel_key ^ pair.wrapping_mul(0x9e37_79b9_7f4a_7c15)) as u32
-    }
-
-    /// The keys of the next pair.
-    #[inline]
+    /// The keys of the next pair: those of its seed, a hash of `(seed, pixel, pair)`, kept or
+    /// made.
+    #[inline(always)]
     fn next_keys(&mut self) -> PairKeys {
         let pair = self.pair;
         self.pair += 1;
-        if pair >= KEPT_PAIRS as u64 {
-            return PairKeys::of(self.seed(pair));
+        if let Some(kept) = &self.kept
+            && pair < KEPT_PAIRS as u64
+            && kept.made & (1 << pair) != 0
+        {
+            return kept.keys[pair as usize];
         }
-        let bit = 1u32 << pair;
-        if self.kept.made & bit == 0 {
-            self.kept.keys[pair as usize] = PairKeys::of(self.seed(pair));
-            self.kept.made |= bit;
+        self.make_keys(pair)
+    }
+
+    /// The keys of pair `pair`, hashed (and kept where the stream keeps them).
+    #[inline]
+    fn make_keys(&mut self, pair: u64) -> PairKeys {
+        let seed = splitmix64(self.pixel_key ^ pair.wrapping_mul(0x9e37_79b9_7f4a_7c15));
+        let keys = PairKeys::of(seed as u32);
+        if let Some(kept) = &mut self.kept
+            && pair < KEPT_PAIRS as u64
+        {
+            kept.keys[pair as usize] = keys;
+            kept.made |= 1 << pair;
         }
-        self.kept.keys[pair as usize]
+        keys
     }
 
     /// The next pair: point `index` of the pair's scrambled (0,2)-sequence (dimensions 0 and 1).
@@ -317,10 +334,21 @@ impl SampleStream {
         }
     }
 
+    /// [`SampleStream::new`], for drawing several samples of the pixel through
+    /// [`SampleStream::restart`]: a Sobol stream then keeps the pixel's pair keys it makes
+    /// ([`PairKeys`]), so that each pair's are hashed once per pixel, not once per sample (at
+    /// the cost of a 0.4 KiB table per stream, which one sample would not repay).
+    pub fn keeping_keys(kind: SamplerKind, seed: u64, pixel: u64, sample: u32) -> Self {
+        match kind {
+            SamplerKind::Sobol => {
+                SampleStream::Sobol(SobolStream::keeping_keys(seed, pixel, sample))
+            }
+            SamplerKind::Independent => SampleStream::new(kind, seed, pixel, sample),
+        }
+    }
+
     /// Makes this the stream of sample `sample` of the same pixel, from its first number:
-    /// equal to a new one ([`SampleStream::new`]), but a Sobol stream keeps the pixel's pair
-    /// keys it has made ([`PairKeys`]), so a pixel's samples drawn through one stream hash each
-    /// pair's keys once.
+    /// equal to a new one ([`SampleStream::new`]), with the pair keys it kept.
     pub fn restart(&mut self, sample: u32) {
         match self {
             SampleStream::Sobol(s) => s.restart(sample),
@@ -448,7 +476,7 @@ mod tests {
             out
         };
         for kind in [SamplerKind::Sobol, SamplerKind::Independent] {
-            let mut kept = SampleStream::new(kind, 3, 17, 5);
+            let mut kept = SampleStream::keeping_keys(kind, 3, 17, 5);
             for (sample, skip) in [(5, true), (0, false), (7, false), (5, false), (2, true)] {
                 kept.restart(sample);
                 let fresh = draws(&mut SampleStream::new(kind, 3, 17, sample), skip);
