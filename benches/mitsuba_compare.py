@@ -19,7 +19,9 @@ size (the LLVM kernels are then cached), plus the same figure with compilation f
 Each timed render runs `--repeat` times (3), the two renderers alternating, and the least time
 is kept: other work on a shared machine only ever slows a run down. `--adaptive-sampling` also
 times iblkit with its adaptive sampling (the same mean samples per pixel, spent where the pilot
-pass finds noise; docs/RENDERING.md), in two more columns.
+pass finds noise; docs/RENDERING.md), in two more columns. `--regions` adds a table of each
+renderer's error split between the objects' pixels (where iblkit's reference covers any) and
+the rest, which says where one renderer trails the other.
 
 Needs: `pip install mitsuba numpy` (3.9) and a system libLLVM (`apt-get install libllvm15`), and
 a release build of `ibl` (`cargo build --release`). Usage:
@@ -173,6 +175,13 @@ def relative_mse(a, b):
     return float(np.mean((a - b) ** 2 / (b * b + 0.01)))
 
 
+def relative_mse_by_region(a, b, mask):
+    """The shares of `relative_mse(a, b)` from the pixels in `mask` and from the others (they
+    add up to it)."""
+    per_pixel = np.mean((a - b) ** 2 / (b * b + 0.01), axis=2)
+    return float(per_pixel[mask].sum() / per_pixel.size), float(per_pixel[~mask].sum() / per_pixel.size)
+
+
 def run_ibl(scene, width, spp, out, seed=1, extra=()):
     cmd = [IBL, "render", scene, "-o", out, "--width", str(width), "--spp", str(spp),
            "--seed", str(seed), "--layers", "--json", *extra]
@@ -199,6 +208,9 @@ def main():
     parser.add_argument("--adaptive-sampling", action="store_true",
                         help="also time iblkit with --adaptive-sampling (two more columns; its "
                              "reference stays uniform)")
+    parser.add_argument("--regions", action="store_true",
+                        help="also print each renderer's error split between the objects' pixels "
+                             "(where iblkit's reference covers any) and the rest")
     parser.add_argument("--repeat", type=int, default=3,
                         help="time each render this many times, alternating, and keep the least")
     args = parser.parse_args()
@@ -237,6 +249,7 @@ def main():
     print(f"| spp | iblkit s | iblkit relative MSE |{adaptive} Mitsuba ({args.mitsuba_sampler}) s "
           f"(with JIT) | Mitsuba relative MSE |")
     print("|---:|---:|---:|" + ("---:|---:|" if args.adaptive_sampling else "") + "---:|---:|")
+    regions = []
     for spp in args.spp:
         cold_start = time.perf_counter()
         run_mitsuba(scene, spp, seed=7)
@@ -256,8 +269,20 @@ def main():
         t, mt = min(times), min(mtimes)
         adaptive = (f" {min(atimes):.2f} | {relative_mse(aimg, ref_ours):.2e} |"
                     if args.adaptive_sampling else "")
+        if args.regions:
+            alpha = np.array(mi.Bitmap(os.path.join(work, "ref-alpha.png")), dtype=np.float64)
+            mask = (alpha if alpha.ndim == 2 else alpha[:, :, 0]) > 0
+            regions.append((spp, relative_mse_by_region(img, ref_ours, mask),
+                            relative_mse_by_region(mimg, ref_mi, mask), mask.mean()))
         print(f"| {spp} | {t:.2f} | {relative_mse(img, ref_ours):.2e} |{adaptive} {mt:.2f} "
               f"({cold:.2f}) | {relative_mse(mimg, ref_mi):.2e} |")
+    if regions:
+        print(f"\nThe errors' shares: the objects' pixels ({100 * regions[0][3]:.1f} % of the "
+              "image) and the rest\n")
+        print("| spp | iblkit objects | iblkit rest | Mitsuba objects | Mitsuba rest |")
+        print("|---:|---:|---:|---:|---:|")
+        for spp, (io, ir), (mo, mr), _ in regions:
+            print(f"| {spp} | {io:.2e} | {ir:.2e} | {mo:.2e} | {mr:.2e} |")
 
 
 if __name__ == "__main__":
