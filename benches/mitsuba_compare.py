@@ -171,6 +171,12 @@ def mitsuba_scene(scene_path, width, height, workdir, envmap_turn_deg):
     }
 
 
+def view_size(scene_path, width):
+    """The image size of the scene's camera view at `width` pixels across (its aspect kept)."""
+    w0, h0 = tomllib.load(open(scene_path, "rb"))["camera"]["image_size_px"]
+    return width, round(width * h0 / w0)
+
+
 def relative_mse(a, b):
     return float(np.mean((a - b) ** 2 / (b * b + 0.01)))
 
@@ -214,9 +220,7 @@ def main():
     parser.add_argument("--repeat", type=int, default=3,
                         help="time each render this many times, alternating, and keep the least")
     args = parser.parse_args()
-    scene_toml = tomllib.load(open(args.scene, "rb"))
-    w0, h0 = scene_toml["camera"]["image_size_px"]
-    width, height = args.width, round(args.width * h0 / w0)
+    width, height = view_size(args.scene, args.width)
     work = tempfile.mkdtemp(prefix="iblkit-mitsuba-")
 
     # The envmap's turn: the one whose view of the bare probe matches iblkit's background.

@@ -23,7 +23,6 @@ import os
 import statistics
 import sys
 import tempfile
-import tomllib
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
@@ -44,9 +43,7 @@ def main():
     parser.add_argument("--ibl", nargs="+", default=[compare.IBL],
                         help="ibl binaries to time (default: the release build)")
     args = parser.parse_args()
-    scene_toml = tomllib.load(open(args.scene, "rb"))
-    w0, h0 = scene_toml["camera"]["image_size_px"]
-    width, height = args.width, round(args.width * h0 / w0)
+    width, height = compare.view_size(args.scene, args.width)
     work = tempfile.mkdtemp(prefix="iblkit-mitsuba-timing-")
     scene_dict = compare.mitsuba_scene(args.scene, width, height, work, args.envmap_turn)
     scene_dict["sensor"]["sampler"] = {"type": args.mitsuba_sampler, "sample_count": 1}
