@@ -177,15 +177,21 @@ def view_size(scene_path, width):
     return width, round(width * h0 / w0)
 
 
+def relative_error_per_pixel(a, b):
+    """`(a - b)^2 / (b^2 + 0.01)`, the channels' mean, per pixel."""
+    return np.mean((a - b) ** 2 / (b * b + 0.01), axis=2)
+
+
 def relative_mse(a, b):
-    return float(np.mean((a - b) ** 2 / (b * b + 0.01)))
+    return float(np.mean(relative_error_per_pixel(a, b)))
 
 
 def relative_mse_by_region(a, b, mask):
     """The shares of `relative_mse(a, b)` from the pixels in `mask` and from the others (they
     add up to it)."""
-    per_pixel = np.mean((a - b) ** 2 / (b * b + 0.01), axis=2)
-    return float(per_pixel[mask].sum() / per_pixel.size), float(per_pixel[~mask].sum() / per_pixel.size)
+    per_pixel = relative_error_per_pixel(a, b)
+    return (float(per_pixel[mask].sum() / per_pixel.size),
+            float(per_pixel[~mask].sum() / per_pixel.size))
 
 
 def run_ibl(scene, width, spp, out, seed=1, extra=()):
@@ -254,6 +260,9 @@ def main():
           f"(with JIT) | Mitsuba relative MSE |")
     print("|---:|---:|---:|" + ("---:|---:|" if args.adaptive_sampling else "") + "---:|---:|")
     regions = []
+    if args.regions:
+        alpha = np.array(mi.Bitmap(os.path.join(work, "ref-alpha.png")), dtype=np.float64)
+        mask = (alpha if alpha.ndim == 2 else alpha[:, :, 0]) > 0
     for spp in args.spp:
         cold_start = time.perf_counter()
         run_mitsuba(scene, spp, seed=7)
@@ -274,8 +283,6 @@ def main():
         adaptive = (f" {min(atimes):.2f} | {relative_mse(aimg, ref_ours):.2e} |"
                     if args.adaptive_sampling else "")
         if args.regions:
-            alpha = np.array(mi.Bitmap(os.path.join(work, "ref-alpha.png")), dtype=np.float64)
-            mask = (alpha if alpha.ndim == 2 else alpha[:, :, 0]) > 0
             regions.append((spp, relative_mse_by_region(img, ref_ours, mask),
                             relative_mse_by_region(mimg, ref_mi, mask), mask.mean()))
         print(f"| {spp} | {t:.2f} | {relative_mse(img, ref_ours):.2e} |{adaptive} {mt:.2f} "
