@@ -236,18 +236,11 @@ const SHUFFLE_KEY: u32 = 0x79c6_8e4a;
 const SEED_MULTIPLIER: u32 = 0x9c8f_2d3b;
 const DIMENSION_KEYS: [u32; 2] = [0x912f_69ba, 0x174f_18ab];
 
-/// The sample index (given with its bits reversed) shuffled by `key` (Burley's nested uniform
-/// scramble of the index; [`PairKeys::shuffle`]), in reversed-bit order.
-#[inline]
-fn shuffled_rev_index(index_rev: u32, key: u32) -> u32 {
-    owen_scramble_rev(index_rev, key)
-}
-
 /// Two reversed-bit Sobol coordinates Owen-scrambled by `keys` ([`PairKeys::dimensions`]), as
-/// numbers in `[0, 1)`. Both
-/// are turned back by one 64-bit reversal (`reverse(a : b) = reverse(b) : reverse(a)`): the
-/// same bits as two 32-bit ones at half the shifts and masks (the x86-64 baseline has no
-/// bit-reversal instruction), which the pairs of every path draw several times.
+/// numbers in `[0, 1)`. Both are turned back by one 64-bit reversal (`reverse(a : b) =
+/// reverse(b) : reverse(a)`): the same bits as two 32-bit ones at half the shifts and masks
+/// (the x86-64 baseline has no bit-reversal instruction), which the pairs of every path draw
+/// several times.
 #[inline]
 fn scrambled(sobol_rev: [u32; 2], keys: [u32; 2]) -> [f32; 2] {
     let a = owen_scramble_rev(sobol_rev[0], keys[0]);
@@ -296,7 +289,8 @@ impl SobolTables {
     /// seed)`.
     #[inline]
     fn point(&self, index_rev: u32, keys: PairKeys) -> [f32; 2] {
-        let rev = shuffled_rev_index(index_rev, keys.shuffle);
+        // The index shuffled (Burley's nested uniform scramble of the index), still reversed.
+        let rev = owen_scramble_rev(index_rev, keys.shuffle);
         scrambled([self.get(0, rev), self.get(1, rev)], keys.dimensions)
     }
 }

@@ -979,26 +979,27 @@ impl<'a> Tracer<'a> {
         }
     }
 
-    /// Whether a ray along `direction` from the vertex being shaded heads away from the one real
-    /// plane from a virtual vertex clear of it ([`PathState::real_side`]): it cannot meet the
-    /// real layer (an object's rays upwards from above a floor: all of its environment samples,
-    /// half of its BSDF samples).
+    /// Whether a ray along `direction` from the vertex being shaded cannot meet the real layer,
+    /// which is one plane, and so skips it: the vertex lies on that plane
+    /// ([`PathState::on_flat_real`]; it cannot meet it again, [`flat_plane`]: a floor's BSDF
+    /// ray, 6 % of a bunny-on-a-floor render's instructions were its two triangle tests), or
+    /// the ray heads away from it from an object clear of it ([`PathState::real_side`]: an
+    /// object's rays upwards from above a floor, all of its environment samples and half of its
+    /// BSDF samples; 1 %).
     #[inline]
-    fn turned_away(&self, direction: Vec3, state: &PathState) -> bool {
-        state.real_side != 0.0
-            && self
-                .real_plane
-                .is_some_and(|plane| state.real_side * plane.normal.dot(direction) >= 0.0)
+    fn skips_real_layer(&self, direction: Vec3, state: &PathState) -> bool {
+        state.on_flat_real
+            || (state.real_side != 0.0
+                && self
+                    .real_plane
+                    .is_some_and(|plane| state.real_side * plane.normal.dot(direction) >= 0.0))
     }
 
-    /// Closest hit through the active layers; `true` when it is virtual. A ray leaving a vertex
-    /// on a flat real layer ([`PathState::on_flat_real`]) skips that layer, as its shadow rays
-    /// do ([`Tracer::blocked`]): it cannot meet it again ([`flat_plane`]). That spares a floor's
-    /// BSDF ray two triangle tests, 6 % of a bunny-on-a-floor render's instructions. So does a
-    /// ray from an object heading away from that plane ([`Tracer::turned_away`]; 1 %).
+    /// Closest hit through the active layers; `true` when it is virtual. The real layer is
+    /// skipped where the ray cannot meet it ([`Tracer::skips_real_layer`]).
     fn closest(&self, ray: &Ray, state: &mut PathState) -> Option<(SurfacePoint, bool)> {
         state.rays += 1;
-        let real = if state.on_flat_real || self.turned_away(ray.direction, state) {
+        let real = if self.skips_real_layer(ray.direction, state) {
             None
         } else {
             self.scene.real.bvh.closest_hit(ray, 0.0, f32::INFINITY)
@@ -1082,8 +1083,8 @@ impl<'a> Tracer<'a> {
         self.blocked(origin, wi, t_max, &mut [OccluderHint::NONE; 2], state)
     }
 
-    /// One shadow ray: the real layer (unless the vertex lies on a flat one or the ray heads away
-    /// from it, [`Tracer::turned_away`]), then, in the walk
+    /// One shadow ray: the real layer (unless the ray cannot meet it,
+    /// [`Tracer::skips_real_layer`]), then, in the walk
     /// with the objects, the virtual layer, each testing its triangle in `hints` (`[real,
     /// virtual]`) first and leaving its blocker there.
     fn blocked(
@@ -1097,8 +1098,7 @@ impl<'a> Tracer<'a> {
         state.rays += 1;
         let ray = Ray::new(origin, wi);
         let [real, virtual_layer] = hints;
-        if !state.on_flat_real
-            && !self.turned_away(wi, state)
+        if !self.skips_real_layer(wi, state)
             && self.scene.real.bvh.occluded_by(&ray, 0.0, t_max, real)
         {
             return Occlusion::Real;
