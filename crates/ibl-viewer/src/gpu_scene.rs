@@ -41,6 +41,8 @@ pub struct FrameUniform {
     pub occluder: [f32; 4],
     /// Their mean diffuse albedo.
     pub occluder_albedo: [f32; 4],
+    /// The virtual objects' bounding sphere (centre, radius; radius 0 without objects).
+    pub objects_sphere: [f32; 4],
 }
 
 /// `Light` of `gpu_scene.wgsl`.
@@ -402,7 +404,7 @@ mod tests {
     #[test]
     fn structs_match_their_wgsl_sizes() {
         // Sums of the WGSL members (all 16-byte columns): no padding on either side.
-        assert_eq!(std::mem::size_of::<FrameUniform>(), 3 * 64 + 10 * 16);
+        assert_eq!(std::mem::size_of::<FrameUniform>(), 3 * 64 + 11 * 16);
         assert_eq!(std::mem::size_of::<GpuLight>(), 2 * 64 + 6 * 16);
         assert_eq!(std::mem::size_of::<GpuObject>(), 2 * 64 + 16);
         assert_eq!(std::mem::size_of::<GpuMaterial>(), 32);

@@ -31,6 +31,9 @@ struct Frame {
     // `occluder_change`); zero when the scene has none.
     occluder: vec4<f32>,
     occluder_albedo: vec4<f32>,
+    // The virtual objects' bounding sphere (centre, radius): what the point lights' virtual
+    // faces are fitted to (light_tiles.wgsl's `point_shadow_reaches`); radius 0 without objects.
+    objects_sphere: vec4<f32>,
 };
 
 // Lights a frame draws (gpu_scene.rs's MAX_SHADOWED_LIGHTS): a uniform array of this many.
@@ -153,12 +156,14 @@ fn oct_decode(e: vec2<f32>) -> vec3<f32> {
 const GBUFFER_SAMPLES: u32 = 4u;
 
 // The light masks of light_tiles.wgsl: per LIGHT_TILE x LIGHT_TILE pixel tile, LIGHT_WORDS
-// words of one bit per light (light_tiles.rs's TILE and WORDS).
+// words of one bit per directional light, then POINT_LIGHT_WORDS of one bit per point light
+// (light_tiles.rs's TILE, WORDS and POINT_WORDS).
 const LIGHT_TILE: u32 = 8u;
 const LIGHT_WORDS: u32 = 8u;
+const POINT_LIGHT_WORDS: u32 = 2u;
 
 // The first mask word of screen tile `tile` in a frame `width` pixels wide.
 fn light_mask_base(tile: vec2<u32>, width: u32) -> u32 {
     let tiles_x = (width + LIGHT_TILE - 1u) / LIGHT_TILE;
-    return (tile.y * tiles_x + tile.x) * LIGHT_WORDS;
+    return (tile.y * tiles_x + tile.x) * (LIGHT_WORDS + POINT_LIGHT_WORDS);
 }

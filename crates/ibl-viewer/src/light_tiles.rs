@@ -1,24 +1,30 @@
 //! Light culling per screen tile for the real layer (`light_tiles.wgsl`): between the scene's
 //! geometry and shading passes, a compute pass marks, for each 8 x 8 pixel tile, the lights
-//! whose virtual-object shadow can reach the tile's real surfaces (against each light's caster
-//! cells, `caster_cells.rs`). A real surface is changed only by those lights (the composite's
-//! `with - without`), so the shading pass loops over them alone; a virtual object still takes
-//! every light. The test is conservative: the frame is the same as with every light tested per
+//! whose virtual-object shadow can reach the tile's real surfaces (a directional light against
+//! its caster cells, `caster_cells.rs`; a point light against the cone the objects' bounding
+//! sphere casts from it), and the new point lights that can light them. A real surface is
+//! changed only by those lights (the composite's `with - without`, and a new light's whole
+//! light), so the shading pass loops over them alone; a virtual object still takes every
+//! light. The test is conservative: the frame is the same as with every light tested per
 //! pixel (`tests/light_culling.rs` compares the two; the GPU-against-CPU checks in
 //! `tests/against_cpu.rs` run through it).
 
 use crate::gpu::GpuContext;
-use crate::gpu_scene::{GpuScene, MAX_SHADOWED_LIGHTS};
+use crate::gpu_scene::{GpuScene, MAX_POINT_LIGHTS, MAX_SHADOWED_LIGHTS};
 
 /// Screen tile side, pixels (`gpu_scene.wgsl`'s `LIGHT_TILE`).
 pub const TILE: u32 = 8;
-/// Mask words per tile: one bit per light (`gpu_scene.wgsl`'s `LIGHT_WORDS`).
+/// Mask words per tile for the directional lights: one bit per light (`gpu_scene.wgsl`'s
+/// `LIGHT_WORDS`).
 pub const WORDS: u32 = (MAX_SHADOWED_LIGHTS as u32).div_ceil(32);
-/// Fewest lights for which the culling runs: it costs about 13 ms a 640 x 480 frame on
-/// lavapipe, and one light tested per pixel costs less (the courtyard's sun, BENCHMARKS.md).
-pub const MIN_TILED_LIGHTS: u32 = 2;
-/// Invocations per workgroup side (`@workgroup_size`).
+/// Mask words per tile for the point lights, after the directional ones (`POINT_LIGHT_WORDS`).
+pub const POINT_WORDS: u32 = (MAX_POINT_LIGHTS as u32).div_ceil(32);
+/// Invocations per workgroup side (`@workgroup_size`), one per tile.
 const GROUP: u32 = 8;
+/// Fewest lights of either kind for which the culling runs: it costs about 13 ms a 640 x 480
+/// frame on lavapipe, and one light tested per pixel costs less (the courtyard's sun,
+/// BENCHMARKS.md).
+pub const MIN_TILED_LIGHTS: u32 = 2;
 
 /// Tiles across and down a frame of `size` pixels.
 pub fn tile_counts(size: (u32, u32)) -> (u32, u32) {
@@ -28,7 +34,7 @@ pub fn tile_counts(size: (u32, u32)) -> (u32, u32) {
 /// Bytes of the mask buffer of a frame of `size` pixels.
 pub fn mask_bytes(size: (u32, u32)) -> u64 {
     let (x, y) = tile_counts(size);
-    u64::from(x) * u64::from(y) * u64::from(WORDS) * 4
+    u64::from(x) * u64::from(y) * u64::from(WORDS + POINT_WORDS) * 4
 }
 
 /// The culling pipeline.
@@ -83,6 +89,7 @@ impl LightTiles {
                 buffer(4, wgpu::BufferBindingType::Storage { read_only: false }),
                 buffer(5, wgpu::BufferBindingType::Storage { read_only: true }),
                 samples(6),
+                buffer(7, wgpu::BufferBindingType::Uniform),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -143,6 +150,10 @@ impl LightTiles {
                     binding: 6,
                     resource: view(&gbuffer[2]),
                 },
+                wgpu::BindGroupEntry {
+                    binding: 7,
+                    resource: scene.point_lights.as_entire_binding(),
+                },
             ],
         })
     }
@@ -175,12 +186,13 @@ mod tests {
         let shared = include_str!("gpu_scene.wgsl");
         assert!(shared.contains(&format!("const LIGHT_TILE: u32 = {TILE}u;")));
         assert!(shared.contains(&format!("const LIGHT_WORDS: u32 = {WORDS}u;")));
+        assert!(shared.contains(&format!("const POINT_LIGHT_WORDS: u32 = {POINT_WORDS}u;")));
         let samples = crate::frame_targets::MSAA_SAMPLES;
         assert!(shared.contains(&format!("const GBUFFER_SAMPLES: u32 = {samples}u;")));
         let source = include_str!("light_tiles.wgsl");
         assert!(source.contains(&format!("@workgroup_size({GROUP}, {GROUP})")));
         assert_eq!(tile_counts((640, 480)), (80, 60));
         assert_eq!(tile_counts((641, 1)), (81, 1));
-        assert_eq!(mask_bytes((8, 8)), u64::from(WORDS) * 4);
+        assert_eq!(mask_bytes((8, 8)), u64::from(WORDS + POINT_WORDS) * 4);
     }
 }

@@ -2,9 +2,12 @@
 // gpu_scene.wgsl.
 //
 // On a real surface the scene pass needs only the lights whose shadow the virtual objects can
-// cast there (difference and ratio rules alike: the change `with - without` is 0 elsewhere).
-// A light is kept for a tile when the box of the tile's real samples can see a caster through
-// the shadow look-up (`reaches`, against the light's caster cells). Conservative, so the
+// cast there (difference and ratio rules alike: the change `with - without` is 0 elsewhere),
+// and the new point lights (their whole light is a change). A directional light is kept for a
+// tile when the box of the tile's real samples can see a caster through the shadow look-up
+// (`reaches`, against the light's caster cells), a point light already in the background when
+// the box's bounding sphere meets the cone of the objects' bounding sphere from it
+// (`point_shadow_reaches`). Conservative, so the
 // composite is unchanged; the shading pass then loops over a tile's own lights, the same count
 // for every pixel of the tile, instead of testing every light per pixel.
 
@@ -17,6 +20,8 @@
 
 // The caster cells of every light (caster_cells.wgsl).
 @group(0) @binding(5) var<storage, read> caster_cells: array<f32>;
+// The goniometric point lights (point_lights.wgsl).
+@group(0) @binding(7) var<uniform> point_lights: array<PointLight, MAX_POINT_LIGHTS>;
 
 // Whether light i's virtual-object shadow can reach a tile's real points, which lie in the box
 // (lo, hi). A receiver sees a caster through its hard tap within the look-up's normal offset (at
@@ -56,6 +61,62 @@ fn faces(i: u32, lo: vec3<f32>, hi: vec3<f32>) -> bool {
     return dot(max(lo * w, hi * w), vec3<f32>(1.0)) > 0.0;
 }
 
+// Whether a sphere (centre, radius) can hold a point that point light k's virtual faces
+// shadow (point_lights.wgsl's `point_atlas_visibility`). The faces hold only the virtual
+// objects, which lie in their bounding sphere (frame.objects_sphere): a texel holds a caster
+// only where its centre's direction lies in the cone the sphere subtends from the light, and
+// only behind the sphere's nearest point. A look-up's direction strays from the receiver's by
+// its normal offset (at most 3.5 texels at the receiver's distance along the face's axis, a
+// texel being 2 / texels of the face's tangent plane: 7 / texels radians), the texel centres
+// its bilinear tap reads lie within a texel on each axis of it (2 sqrt(2) / texels) and its
+// clamp to the tile moves it by at most half a texel (1 / texels): under 11 / texels radians in
+// all, taken as 12, and 12 / texels of the distance besides. The sphere reaches the cone when
+// the angle between the two axes is within the two half-angles and that margin, compared as
+// cosines (the sum of the three angles by the addition formulas; past pi, always); and always
+// when the light is inside either sphere.
+fn point_shadow_reaches(k: u32, centre: vec3<f32>, radius: f32) -> bool {
+    let objects = frame.objects_sphere;
+    if objects.w <= 0.0 {
+        // No objects: nothing in the virtual faces.
+        return false;
+    }
+    let light = point_lights[k].position.xyz;
+    let margin = 12.0 / point_lights[k].shadow.y;
+    let to_objects = objects.xyz - light;
+    let d_objects = length(to_objects);
+    let to_sphere = centre - light;
+    let d_sphere = length(to_sphere);
+    if d_objects <= objects.w || d_sphere <= radius {
+        return true;
+    }
+    if (d_sphere + radius) * (1.0 + margin) < d_objects - objects.w {
+        // The whole sphere is nearer the light than any caster.
+        return false;
+    }
+    let sin_cone = objects.w / d_objects;
+    let cos_cone = sqrt(max(1.0 - sin_cone * sin_cone, 0.0));
+    let sin_spread = radius / d_sphere;
+    let cos_spread = sqrt(max(1.0 - sin_spread * sin_spread, 0.0));
+    let cos_both = cos_cone * cos_spread - sin_cone * sin_spread;
+    let sin_both = sin_cone * cos_spread + cos_cone * sin_spread;
+    let cos_m = cos(margin);
+    let sin_m = sin(margin);
+    let cos_all = cos_both * cos_m - sin_both * sin_m;
+    let sin_all = sin_both * cos_m + cos_both * sin_m;
+    return sin_all < 0.0 || dot(to_objects, to_sphere) >= cos_all * d_objects * d_sphere;
+}
+
+// Whether some normal in the box (normals_lo, normals_hi) faces point light k from some point
+// in the box (lo, hi): the largest `n . (light - p)` over both boxes, a sum of per-axis products
+// whose largest is at a corner of the two intervals, is positive (reflection() is 0 elsewhere).
+fn faces_point(k: u32, lo: vec3<f32>, hi: vec3<f32>, normals_lo: vec3<f32>, normals_hi: vec3<f32>) -> bool {
+    let light = point_lights[k].position.xyz;
+    let near = light - hi;
+    let far = light - lo;
+    let most = max(max(normals_lo * near, normals_lo * far), max(normals_hi * near, normals_hi * far));
+    return most.x + most.y + most.z > 0.0;
+}
+
 @compute @workgroup_size(8, 8)
 fn cs_light_tiles(@builtin(global_invocation_id) id: vec3<u32>) {
     let size = textureDimensions(gbuffer_depth);
@@ -89,8 +150,8 @@ fn cs_light_tiles(@builtin(global_invocation_id) id: vec3<u32>) {
             }
         }
     }
-    let count = frame.counts.x;
     let base = light_mask_base(id.xy, size.x);
+    let count = frame.counts.x;
     for (var w = 0u; w < LIGHT_WORDS; w = w + 1u) {
         var bits = 0u;
         for (var k = 0u; k < 32u; k = k + 1u) {
@@ -100,5 +161,21 @@ fn cs_light_tiles(@builtin(global_invocation_id) id: vec3<u32>) {
             }
         }
         masks[base + w] = bits;
+    }
+    // A point light already in the background changes a real surface only by the objects'
+    // shadow; a new one by all its light.
+    let points = frame.counts.y;
+    let centre = 0.5 * (lo + hi);
+    let radius = 0.5 * length(hi - lo);
+    for (var w = 0u; w < POINT_LIGHT_WORDS; w = w + 1u) {
+        var bits = 0u;
+        for (var b = 0u; b < 32u; b = b + 1u) {
+            let k = w * 32u + b;
+            if real && k < points && faces_point(k, lo, hi, normals_lo, normals_hi)
+                && (point_lights[k].shadow.z < 0.5 || point_shadow_reaches(k, centre, radius)) {
+                bits = bits | (1u << b);
+            }
+        }
+        masks[base + LIGHT_WORDS + w] = bits;
     }
 }

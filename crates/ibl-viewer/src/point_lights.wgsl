@@ -113,37 +113,74 @@ fn point_arrival(k: u32, m: Material, p: vec3<f32>, f: SurfaceFrame, wo: vec3<f3
 // patch, shadow.z = 1) gives it only the objects' shadow, `with - without` as for the
 // directional lights (Grosch's `dL_i = rho E_i / pi` where the objects block it). A virtual
 // object takes the light unless shadow.w = 0 (Grosch's fast display).
-fn add_point_lights(m: Material, p: vec3<f32>, f: SurfaceFrame, wo: vec3<f32>, on_virtual: bool, sums_in: LightSums) -> LightSums {
+//
+// On lavapipe a light skipped per pixel still costs its whole body (a branch that differs
+// between pixels runs both sides), while a loop costs only the trips some pixel of the block
+// takes. So a real surface loops only over the point lights its screen tile's mask names
+// (light_tiles.wgsl's point words, from word `mask_base + LIGHT_WORDS`), and in two passes: the
+// first finds the lights that change the pixel (a new light where it shines; one already in the
+// background only where the objects' shadow falls: one virtual-atlas look-up), the second
+// shades those alone. A light the tile keeps but whose shadow misses the pixel costs the
+// look-up, not the intensity and the real shadow too. (Testing the pixel against the shadow's
+// cone, as the tile is, in place of the look-up kept more lights and was slower.)
+fn add_point_lights(m: Material, p: vec3<f32>, f: SurfaceFrame, wo: vec3<f32>, on_virtual: bool, sums_in: LightSums, mask_base: u32) -> LightSums {
     var sums = sums_in;
     let count = frame.counts.y;
-    for (var k = 0u; k < count; k = k + 1u) {
-        let in_background = point_lights[k].shadow.z > 0.5;
-        if on_virtual && point_lights[k].shadow.w < 0.5 {
-            continue;
+    let words = (count + 31u) / 32u;
+    for (var word = 0u; word < words; word = word + 1u) {
+        var bits = 0xffffffffu;
+        if TILED_LIGHTS && !on_virtual {
+            bits = light_masks[mask_base + LIGHT_WORDS + word];
         }
-        let a = point_arrival(k, m, p, f, wo);
-        if all(a.fc <= vec3<f32>(0.0)) {
-            continue;
+        let left = count - 32u * word;
+        if left < 32u {
+            bits = bits & ((1u << left) - 1u);
         }
-        let cos_light = dot(f.ng, a.wi);
-        let vv = point_atlas_visibility(virtual_atlas, frame.atlas.zw, k, false, a.light, p, f.ng, cos_light);
-        if !on_virtual && in_background && vv >= 1.0 {
-            // Not shadowed by the objects: with and without agree.
-            continue;
+        // The lights of this word that change the pixel.
+        var changing = 0u;
+        loop {
+            if bits == 0u {
+                break;
+            }
+            let b = firstTrailingBit(bits);
+            bits = bits & (bits - 1u);
+            let k = 32u * word + b;
+            if on_virtual && point_lights[k].shadow.w < 0.5 {
+                continue;
+            }
+            let a = point_arrival(k, m, p, f, wo);
+            if all(a.fc <= vec3<f32>(0.0)) {
+                continue;
+            }
+            if !on_virtual && point_lights[k].shadow.z > 0.5 {
+                let cos_light = dot(f.ng, a.wi);
+                let vv = point_atlas_visibility(virtual_atlas, frame.atlas.zw, k, false, a.light, p, f.ng, cos_light);
+                if vv >= 1.0 {
+                    // Not shadowed by the objects: with and without agree.
+                    continue;
+                }
+            }
+            changing = changing | (1u << b);
         }
-        let e = point_light_term(k, a.fc, a.wi, a.d2);
-        if all(e <= vec3<f32>(0.0)) {
-            continue;
-        }
-        let lit = e * point_real_visibility(k, a.light, p, f.ng, cos_light);
-        if on_virtual {
-            sums.direct = sums.direct + lit * vv;
-        } else if in_background {
-            sums.affected = true;
-            sums.change = sums.change + lit * (vv - 1.0);
-        } else {
-            sums.affected = true;
-            sums.change = sums.change + lit * vv;
+        loop {
+            if changing == 0u {
+                break;
+            }
+            let k = 32u * word + firstTrailingBit(changing);
+            changing = changing & (changing - 1u);
+            let a = point_arrival(k, m, p, f, wo);
+            let cos_light = dot(f.ng, a.wi);
+            let vv = point_atlas_visibility(virtual_atlas, frame.atlas.zw, k, false, a.light, p, f.ng, cos_light);
+            let lit = point_light_term(k, a.fc, a.wi, a.d2) * point_real_visibility(k, a.light, p, f.ng, cos_light);
+            if on_virtual {
+                sums.direct = sums.direct + lit * vv;
+            } else if point_lights[k].shadow.z > 0.5 {
+                sums.affected = true;
+                sums.change = sums.change + lit * (vv - 1.0);
+            } else {
+                sums.affected = true;
+                sums.change = sums.change + lit * vv;
+            }
         }
     }
     return sums;

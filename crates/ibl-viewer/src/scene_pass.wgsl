@@ -512,7 +512,7 @@ fn shade_surface(s: Surface, pixel: vec2<f32>, pixel_noise: f32, mask_base: u32)
     f.ng = s.ng;
     var sums = light_sums(m, s.p, f, wo, on_virtual, pixel_noise, mask_base);
     if POINT_LIGHTS {
-        sums = add_point_lights(m, s.p, f, wo, on_virtual, sums);
+        sums = add_point_lights(m, s.p, f, wo, on_virtual, sums, mask_base);
     }
     if OCCLUSION_GATHER && !on_virtual {
         let gathered = occluder_change(m, s.p, f.ns);

@@ -344,6 +344,9 @@ impl SceneRenderer {
                 }
                 None => [0.0; 4],
             },
+            objects_sphere: model
+                .objects_sphere()
+                .map_or([0.0; 4], |(c, r)| [c.x, c.y, c.z, r]),
         }
     }
 
@@ -357,7 +360,9 @@ impl SceneRenderer {
         occlusion_gather: bool,
     ) -> ShaderVariant {
         ShaderVariant {
-            tiled_lights: settings.light_culling && lights >= crate::light_tiles::MIN_TILED_LIGHTS,
+            tiled_lights: settings.light_culling
+                && (lights >= crate::light_tiles::MIN_TILED_LIGHTS
+                    || points >= crate::light_tiles::MIN_TILED_LIGHTS),
             soft_shadows: model.description.lighting.shadows == ibl_scene::ShadowKind::Soft,
             ratio_rule: model.description.render.composite == CompositeRule::Ratio,
             photo_background: matches!(model.scene.background, Background::Photo(_)),
