@@ -181,6 +181,11 @@ pub struct ViewArgs {
     /// measuring what it saves).
     #[arg(long)]
     pub no_light_culling: bool,
+    /// Draw every triangle of a closed virtual object into the shadow maps instead of only
+    /// those facing the light (the same shadow maps, slower; for checking the culling or
+    /// measuring what it saves).
+    #[arg(long)]
+    pub no_shadow_culling: bool,
     /// Camera yaw over a probe, degrees (0 looks along -Z, positive looks left).
     #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
     pub yaw: Option<f32>,
@@ -302,6 +307,7 @@ pub fn run(args: &ViewArgs, progress: &dyn Progress) -> Result<Option<ViewSummar
             display: None,
             sky_lights: args.sky_lights as usize,
             light_culling: !args.no_light_culling,
+            shadow_culling: !args.no_shadow_culling,
         },
         exposure_stops: args.exposure,
         curve: ToneCurve::from(args.tonemap),

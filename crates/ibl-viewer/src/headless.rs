@@ -61,6 +61,9 @@ pub struct HeadlessOptions {
     pub sky_lights: usize,
     /// Per-tile light culling on real surfaces ([`SceneFrameSettings::light_culling`]).
     pub light_culling: bool,
+    /// Closed objects' away-facing triangles left out of the shadow maps
+    /// ([`SceneFrameSettings::shadow_culling`]).
+    pub shadow_culling: bool,
 }
 
 impl Default for HeadlessOptions {
@@ -75,6 +78,7 @@ impl Default for HeadlessOptions {
             display: None,
             sky_lights: 0,
             light_culling: true,
+            shadow_culling: true,
         }
     }
 }
@@ -289,6 +293,7 @@ pub fn render_scene_lit(
             shadow_tile: options.shadow_tile,
             selected: None,
             light_culling: options.light_culling,
+            shadow_culling: options.shadow_culling,
         };
         let started = Instant::now();
         let report = renderer.render(gpu, &moving, &settings);
@@ -344,6 +349,7 @@ pub fn render_sequence(
         shadow_tile: options.shadow_tile,
         selected: None,
         light_culling: options.light_culling,
+        shadow_culling: options.shadow_culling,
     };
     let frames = options.frames.max(1) as usize;
     let mut timings = Vec::with_capacity(frames);

@@ -43,6 +43,102 @@ pub struct ObjectGeometry {
     pub bounds: (Vec3, Vec3),
     /// Global material indices this object uses.
     pub materials: Range<u32>,
+    /// Whether its triangles close a volume, and which way they wind (the shadow passes draw
+    /// only the light-facing triangles of a closed object: `shadow_atlas.rs`).
+    pub closure: Closure,
+}
+
+/// How an object's triangles bound a volume.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Closure {
+    /// Not closed (or not known to be): some edge is not shared by exactly two triangles that
+    /// run along it in opposite directions, or parts wind opposite ways.
+    Open,
+    /// Closed, each triangle counter-clockwise seen from outside (its right-hand normal points
+    /// out: every connected part has a positive signed volume).
+    Outward,
+    /// Closed, each triangle clockwise seen from outside (every part's volume negative).
+    Inward,
+}
+
+impl Closure {
+    /// +1 for [`Closure::Outward`], -1 for [`Closure::Inward`], `None` when open.
+    pub fn sign(self) -> Option<f32> {
+        match self {
+            Closure::Open => None,
+            Closure::Outward => Some(1.0),
+            Closure::Inward => Some(-1.0),
+        }
+    }
+
+    /// The closure of `vertices` (three per triangle), their corners joined where positions are
+    /// equal bit for bit. Closed when every directed edge of a triangle (corner order) meets
+    /// its reverse in exactly one other triangle and no edge twice: then a ray from outside the
+    /// volume enters it first through a triangle whose front (right-hand) side faces the ray's
+    /// origin, when every connected part winds the same way (each part's signed volume, the sum
+    /// of `a . (b x c) / 6` over its triangles, has the same sign and is not zero). Triangles
+    /// with two equal corners are left out (they cover nothing). O(n) expected.
+    pub fn of(vertices: &[Vertex]) -> Closure {
+        let mut id_of: HashMap<[u32; 3], u32> = HashMap::with_capacity(vertices.len() / 4);
+        let mut ids = Vec::with_capacity(vertices.len());
+        for v in vertices {
+            let next = id_of.len() as u32;
+            ids.push(*id_of.entry(bytemuck::cast(v.position)).or_insert(next));
+        }
+        let triangles: Vec<[u32; 3]> = ids
+            .chunks_exact(3)
+            .map(|t| [t[0], t[1], t[2]])
+            .filter(|t| t[0] != t[1] && t[1] != t[2] && t[2] != t[0])
+            .collect();
+        if triangles.is_empty() {
+            return Closure::Open;
+        }
+        let mut edges: HashMap<(u32, u32), u32> = HashMap::with_capacity(3 * triangles.len());
+        for t in &triangles {
+            for k in 0..3 {
+                *edges.entry((t[k], t[(k + 1) % 3])).or_insert(0) += 1;
+            }
+        }
+        let closed = edges
+            .iter()
+            .all(|(&(a, b), &n)| n == 1 && edges.get(&(b, a)) == Some(&1));
+        if !closed {
+            return Closure::Open;
+        }
+        // Connected parts (union-find over the corners), and each part's signed volume.
+        let mut parent: Vec<u32> = (0..id_of.len() as u32).collect();
+        fn root(parent: &mut [u32], mut i: u32) -> u32 {
+            while parent[i as usize] != i {
+                let up = parent[parent[i as usize] as usize];
+                parent[i as usize] = up;
+                i = up;
+            }
+            i
+        }
+        for t in &triangles {
+            let a = root(&mut parent, t[0]);
+            for &c in &t[1..] {
+                let b = root(&mut parent, c);
+                parent[b as usize] = a;
+            }
+        }
+        let mut position = vec![Vec3::ZERO; id_of.len()];
+        for (v, &id) in vertices.iter().zip(&ids) {
+            position[id as usize] = Vec3::from(v.position);
+        }
+        let mut volume: HashMap<u32, f64> = HashMap::new();
+        for t in &triangles {
+            let [a, b, c] = t.map(|i| position[i as usize].as_dvec3());
+            *volume.entry(root(&mut parent, t[0])).or_insert(0.0) += a.dot(b.cross(c)) / 6.0;
+        }
+        if volume.values().all(|&v| v > 0.0) {
+            Closure::Outward
+        } else if volume.values().all(|&v| v < 0.0) {
+            Closure::Inward
+        } else {
+            Closure::Open
+        }
+    }
 }
 
 /// Everything the viewer draws.
@@ -99,6 +195,7 @@ fn object(name: String, vertices: Vec<Vertex>) -> ObjectGeometry {
     });
     ObjectGeometry {
         name,
+        closure: Closure::of(&vertices),
         bounds: bounds_of(&vertices),
         bvh: Bvh::new(&corners),
         materials: if vertices.is_empty() {
@@ -194,6 +291,79 @@ mod tests {
             objects: Vec::new(),
             materials: Vec::new(),
         }
+    }
+
+    /// The unit cube about `centre` as triangles wound counter-clockwise seen from outside
+    /// (normals and materials vary per face, as a mesh's split vertices do), less the faces
+    /// in `missing` (0 to 5).
+    fn cube(centre: Vec3, missing: &[usize]) -> Vec<Vertex> {
+        let mut out = Vec::new();
+        for face in 0..6 {
+            if missing.contains(&face) {
+                continue;
+            }
+            let axis = face / 2;
+            let sign = if face % 2 == 0 { 1.0 } else { -1.0 };
+            let mut n = Vec3::ZERO;
+            n[axis] = sign;
+            let (mut u, mut v) = (Vec3::ZERO, Vec3::ZERO);
+            u[(axis + 1) % 3] = 0.5;
+            v[(axis + 2) % 3] = 0.5;
+            let c = centre + 0.5 * n;
+            let mut quad = [c - u - v, c + u - v, c + u + v, c - u + v];
+            if (quad[1] - quad[0]).cross(quad[2] - quad[0]).dot(n) < 0.0 {
+                quad.reverse();
+            }
+            for k in [0, 1, 2, 0, 2, 3] {
+                out.push(Vertex {
+                    position: quad[k].to_array(),
+                    normal: n.to_array(),
+                    material: face as u32,
+                });
+            }
+        }
+        out
+    }
+
+    fn reversed(vertices: &[Vertex]) -> Vec<Vertex> {
+        vertices
+            .chunks_exact(3)
+            .flat_map(|t| [t[0], t[2], t[1]])
+            .collect()
+    }
+
+    #[test]
+    fn a_closed_mesh_is_told_from_an_open_one_and_its_winding_found() {
+        let outward = cube(Vec3::new(3.0, -2.0, 7.0), &[]);
+        assert_eq!(Closure::of(&outward), Closure::Outward);
+        assert_eq!(Closure::of(&reversed(&outward)), Closure::Inward);
+        assert_eq!(
+            Closure::of(&cube(Vec3::ZERO, &[4])),
+            Closure::Open,
+            "a face missing"
+        );
+        // One triangle flipped: its edges run the same way as their neighbours'.
+        let mut flipped = outward.clone();
+        flipped.swap(1, 2);
+        assert_eq!(Closure::of(&flipped), Closure::Open);
+        // A face doubled: its edges are shared by three triangles.
+        let mut doubled = outward.clone();
+        doubled.extend_from_slice(&outward[..6]);
+        assert_eq!(Closure::of(&doubled), Closure::Open);
+        // Two closed parts that wind the same way, and two that do not.
+        let mut two = outward.clone();
+        two.extend(cube(Vec3::new(-5.0, 0.0, 0.0), &[]));
+        assert_eq!(Closure::of(&two), Closure::Outward);
+        let mut mixed = outward.clone();
+        mixed.extend(reversed(&cube(Vec3::new(-5.0, 0.0, 0.0), &[])));
+        assert_eq!(Closure::of(&mixed), Closure::Open);
+        // A degenerate triangle (two equal corners) covers nothing and changes nothing.
+        let mut sliver = outward.clone();
+        sliver.extend([outward[0], outward[0], outward[1]]);
+        assert_eq!(Closure::of(&sliver), Closure::Outward);
+        assert_eq!(Closure::of(&[]), Closure::Open);
+        assert_eq!(Closure::Outward.sign(), Some(1.0));
+        assert_eq!(Closure::Open.sign(), None);
     }
 
     #[test]

@@ -145,28 +145,36 @@ impl SceneModel {
         self.description.object[i].world_from_model() * self.load_placements[i].inverse()
     }
 
-    /// The bounding sphere of every virtual object as placed now (`None` without objects).
-    pub fn objects_sphere(&self) -> Option<(Vec3, f32)> {
+    /// The world box of virtual object `i` as placed now, `(min, max)` (`None` when it has no
+    /// triangles): its load bounds' corners moved by `world_from_load`.
+    pub fn object_box(&self, i: usize) -> Option<(Vec3, Vec3)> {
+        let g = &self.geometry.objects[i];
+        if g.vertices.is_empty() {
+            return None;
+        }
+        let m = self.world_from_load(i);
+        let (a, b) = g.bounds;
         let mut lo = Vec3::splat(f32::INFINITY);
         let mut hi = Vec3::splat(f32::NEG_INFINITY);
-        for (i, g) in self.geometry.objects.iter().enumerate() {
-            if g.vertices.is_empty() {
-                continue;
-            }
-            let m = self.world_from_load(i);
-            let (a, b) = g.bounds;
-            for k in 0..8 {
-                let corner = Vec3::new(
-                    if k & 1 == 0 { a.x } else { b.x },
-                    if k & 2 == 0 { a.y } else { b.y },
-                    if k & 4 == 0 { a.z } else { b.z },
-                );
-                let p = m.transform_point3(corner);
-                lo = lo.min(p);
-                hi = hi.max(p);
-            }
+        for k in 0..8 {
+            let corner = Vec3::new(
+                if k & 1 == 0 { a.x } else { b.x },
+                if k & 2 == 0 { a.y } else { b.y },
+                if k & 4 == 0 { a.z } else { b.z },
+            );
+            let p = m.transform_point3(corner);
+            lo = lo.min(p);
+            hi = hi.max(p);
         }
-        (lo.x <= hi.x).then(|| crate::light_space::bounding_sphere(lo, hi))
+        Some((lo, hi))
+    }
+
+    /// The bounding sphere of every virtual object as placed now (`None` without objects).
+    pub fn objects_sphere(&self) -> Option<(Vec3, f32)> {
+        let (lo, hi) = (0..self.geometry.objects.len())
+            .filter_map(|i| self.object_box(i))
+            .reduce(|(lo, hi), (a, b)| (lo.min(a), hi.max(b)))?;
+        Some(crate::light_space::bounding_sphere(lo, hi))
     }
 
     /// The materials of every triangle slot as edited (real first, then each object's).

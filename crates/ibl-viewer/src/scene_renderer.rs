@@ -20,7 +20,7 @@ use crate::gpu_scene::{FrameUniform, GpuLight, GpuObject, GpuScene, mat3_columns
 use crate::lighting::SceneLighting;
 use crate::scene_model::SceneModel;
 use crate::scene_pass::{SceneBindGroups, ScenePass, ScenePassInputs, ShaderVariant};
-use crate::shadow_atlas::ShadowAtlases;
+use crate::shadow_atlas::{CasterFacing, ShadowAtlases};
 use crate::textures::{HdrTexture, black_texture, upload_hdr};
 use crate::timing::{PassTimer, PassTimes, SCENE_PASSES};
 use crate::view_camera::OutputCamera;
@@ -55,6 +55,9 @@ pub struct SceneFrameSettings {
     /// Real surfaces take only their screen tile's lights (`light_tiles.rs`; the same frame,
     /// faster); false tests every light on every real pixel (for checking the culling).
     pub light_culling: bool,
+    /// Closed virtual objects draw only their light-facing triangles into the shadow maps
+    /// (`shadow_atlas.rs`; the same atlas, faster); false draws every triangle (for checking).
+    pub shadow_culling: bool,
 }
 
 /// What a frame did.
@@ -477,8 +480,9 @@ impl SceneRenderer {
         }
         if draw_virtual && any_lights {
             let t = self.timer.as_mut().and_then(|t| t.writes(1));
+            let facings = caster_facings(model, settings.shadow_culling);
             self.shadows
-                .draw_virtual(gpu, &mut encoder, &self.gpu_scene, count, t);
+                .draw_virtual(gpu, &mut encoder, &self.gpu_scene, count, &facings, t);
         }
         {
             let t = self.timer.as_mut().and_then(|t| t.split_writes(2));
@@ -513,12 +517,43 @@ impl SceneRenderer {
         }
     }
 
+    /// The virtual objects' shadow atlas as last drawn, for checks: its width, height and
+    /// texels, rows packed, in its format (`ShadowAtlases::virtual_format`: 2 bytes a texel at
+    /// `Depth16Unorm`, 4 at `Depth32Float`).
+    pub fn virtual_atlas_texels(
+        &self,
+        gpu: &GpuContext,
+    ) -> Result<(u32, u32, Vec<u8>), ViewerError> {
+        let atlas = &self.shadows.virtual_objects;
+        let bytes = atlas.format.block_copy_size(None).unwrap_or(4);
+        let texels = crate::frame_targets::read_texture(gpu, &atlas.texture, bytes)?;
+        let (w, h) = atlas.size();
+        Ok((w, h, texels))
+    }
+
     /// Reads the pass times of the last frame (waiting for them with `wait`).
     pub fn read_pass_times(&mut self, gpu: &GpuContext, wait: bool) -> Option<PassTimes> {
         let times = self.timer.as_mut()?.read(gpu, wait)?;
         self.last_pass_times = Some(times.clone());
         Some(times)
     }
+}
+
+/// Per virtual object of `model`, how the shadow passes may cull its triangles now: a closed
+/// object's winding in the world frame (its closure's, turned over by a mirroring placement) and
+/// its bounding sphere; `None` for an open one, or for every object when `culling` is off.
+fn caster_facings(model: &SceneModel, culling: bool) -> Vec<Option<CasterFacing>> {
+    (0..model.object_count())
+        .map(|i| {
+            let winding = model.geometry.objects[i].closure.sign()?;
+            let mirror = model.world_from_load(i).matrix3.determinant().signum();
+            let (lo, hi) = model.object_box(i)?;
+            culling.then(|| CasterFacing {
+                orientation: winding * mirror,
+                sphere: crate::light_space::bounding_sphere(lo, hi),
+            })
+        })
+        .collect()
 }
 
 /// Clears the overlay target (nothing is drawn over a scene frame yet).

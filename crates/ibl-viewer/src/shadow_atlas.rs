@@ -20,6 +20,13 @@
 //! Soft shadows widen each virtual tile by `1 + 2 tan a` (at most 3x) so a penumbra of cone
 //! half-angle `a` fits in it.
 //!
+//! A closed virtual object (`scene_geometry::Closure`) is drawn into the virtual atlas with its
+//! triangles that face away from the light culled: a ray from the light meets a closed surface
+//! first where it enters it, through a triangle facing the light, so every texel keeps the
+//! depth it had (the same triangles rasterised the same way), for half the triangles
+//! ([`away_facing`]; `tests/shadow_culling.rs` compares the atlases texel for texel). An open
+//! object, and any object a point light stands inside, draws every triangle.
+//!
 //! Goniometric point lights take six tiles each after the directional lights' (their cube
 //! faces, `point_lights.rs`), drawn with the same rules: the real faces when the lights change,
 //! the virtual ones when an object moves, and only the faces that see casters.
@@ -84,7 +91,10 @@ impl Atlas {
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
             format,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            // Copied out only by checks (`SceneRenderer::virtual_atlas_texels`).
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_SRC,
             view_formats: &[],
         });
         let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
@@ -142,9 +152,10 @@ pub struct ShadowAtlases {
     /// Virtual objects.
     pub virtual_objects: Atlas,
     real_pipeline: wgpu::RenderPipeline,
-    virtual_pipeline: wgpu::RenderPipeline,
-    /// Point lights' cube faces, both atlases (`vs_point_face`).
-    face_pipeline: wgpu::RenderPipeline,
+    /// The virtual objects for the directional lights, by [`Culling`].
+    virtual_pipelines: [wgpu::RenderPipeline; 3],
+    /// Point lights' cube faces, both atlases (`vs_point_face`), by [`Culling`].
+    face_pipelines: [wgpu::RenderPipeline; 3],
     bind_layout: wgpu::BindGroupLayout,
     /// The point lights as last fitted (their faces' tiles say which faces to draw).
     points: Vec<GpuPointLight>,
@@ -214,7 +225,7 @@ impl ShadowAtlases {
             bind_group_layouts: &[Some(&bind_layout)],
             immediate_size: 0,
         });
-        let pipeline = |entry: &str, format: wgpu::TextureFormat| {
+        let pipeline = |entry: &str, format: wgpu::TextureFormat, culling: Culling| {
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some(entry),
                 layout: Some(&pipeline_layout),
@@ -229,7 +240,9 @@ impl ShadowAtlases {
                     })],
                 },
                 primitive: wgpu::PrimitiveState {
-                    cull_mode: None,
+                    // Counter-clockwise in normalised device coordinates is the front.
+                    front_face: wgpu::FrontFace::Ccw,
+                    cull_mode: culling.face(),
                     ..Default::default()
                 },
                 depth_stencil: Some(wgpu::DepthStencilState {
@@ -249,10 +262,12 @@ impl ShadowAtlases {
         ShadowAtlases {
             real: Atlas::new(gpu, "real shadow atlas", layout, DEPTH_FORMAT),
             virtual_objects: Atlas::new(gpu, "virtual shadow atlas", layout, virtual_format),
-            real_pipeline: pipeline("vs_real_tile", DEPTH_FORMAT),
-            virtual_pipeline: pipeline("vs_virtual_atlas", virtual_format),
+            real_pipeline: pipeline("vs_real_tile", DEPTH_FORMAT, Culling::None),
+            virtual_pipelines: Culling::ALL
+                .map(|culling| pipeline("vs_virtual_atlas", virtual_format, culling)),
             // Drawn into both atlases, which with point lights share the format.
-            face_pipeline: pipeline("vs_point_face", DEPTH_FORMAT),
+            face_pipelines: Culling::ALL
+                .map(|culling| pipeline("vs_point_face", DEPTH_FORMAT, culling)),
             bind_layout,
             points: Vec::new(),
             region: None,
@@ -435,30 +450,41 @@ impl ShadowAtlases {
             pass.set_viewport(x as f32, y as f32, tile, tile, 0.0, 1.0);
             scene.real.draw(&mut pass, i..i + 1);
         }
-        self.draw_faces(&mut pass, &self.real, 0, &scene.real, |p| p.real_faces);
+        self.draw_faces(&mut pass, &self.real, 0, &scene.real, None, |p| {
+            p.real_faces
+        });
     }
 
     /// Draws one caster (`object` 0 the real geometry, `k + 1` virtual object k, its `mesh`
     /// bound) into every point-light face of `atlas` that `faces` gives a tile, the viewport set
-    /// to the tile.
+    /// to the tile; a closed caster (`facing`) without its triangles facing away from the
+    /// light, unless the light stands inside its bounding sphere.
     fn draw_faces(
         &self,
         pass: &mut wgpu::RenderPass<'_>,
         atlas: &Atlas,
         object: u32,
         mesh: &MeshBuffer,
+        facing: Option<CasterFacing>,
         faces: impl Fn(&GpuPointLight) -> [[f32; 4]; FACES],
     ) {
         let (w, h) = atlas.size();
-        let mut bound = false;
+        let mut bound = None;
         for (k, light) in self.points.iter().enumerate() {
+            let position = Vec3::new(light.position[0], light.position[1], light.position[2]);
+            let orientation = facing
+                .filter(|f| position.distance(f.sphere.0) > f.sphere.1)
+                .map(|f| f.orientation);
             for (f, tile) in faces(light).iter().enumerate() {
                 if tile[2] == 0.0 {
                     continue;
                 }
-                if !bound {
-                    pass.set_pipeline(&self.face_pipeline);
-                    bound = true;
+                let culling = orientation.map_or(Culling::None, |o| {
+                    Culling::Face(away_facing(o, face_handedness(f)))
+                });
+                if bound != Some(culling) {
+                    pass.set_pipeline(&self.face_pipelines[culling.index()]);
+                    bound = Some(culling);
                 }
                 pass.set_viewport(
                     tile[0] * w as f32,
@@ -476,13 +502,15 @@ impl ShadowAtlases {
     }
 
     /// Draws the virtual objects into the virtual atlas, all directional lights in one
-    /// instanced draw each, then the point lights' faces.
+    /// instanced draw each, then the point lights' faces. `facings` has one entry per object
+    /// (`None`: draw every triangle, as for an open object).
     pub fn draw_virtual(
         &self,
         gpu: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
         scene: &GpuScene,
         lights: u32,
+        facings: &[Option<CasterFacing>],
         timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
     ) {
         let bind_group = self.bind_group(gpu, scene);
@@ -500,22 +528,130 @@ impl ShadowAtlases {
                 continue;
             }
             let object = k as u32 + 1;
+            let facing = facings.get(k).copied().flatten();
             mesh.bind(&mut pass);
             if lights > 0 {
-                pass.set_pipeline(&self.virtual_pipeline);
+                let culling = facing.map_or(Culling::None, |f| {
+                    Culling::Face(away_facing(f.orientation, DIRECTIONAL_HANDEDNESS))
+                });
+                pass.set_pipeline(&self.virtual_pipelines[culling.index()]);
                 pass.set_viewport(0.0, 0.0, w as f32, h as f32, 0.0, 1.0);
                 mesh.draw(&mut pass, object * lights..(object + 1) * lights);
             }
-            self.draw_faces(&mut pass, &self.virtual_objects, object, mesh, |p| {
-                p.virtual_faces
-            });
+            self.draw_faces(
+                &mut pass,
+                &self.virtual_objects,
+                object,
+                mesh,
+                facing,
+                |p| p.virtual_faces,
+            );
         }
+    }
+}
+
+/// Which triangles a shadow pass leaves out.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Culling {
+    /// None: an open caster.
+    None,
+    /// Those wgpu calls this side (the side facing away from the light).
+    Face(wgpu::Face),
+}
+
+impl Culling {
+    const ALL: [Culling; 3] = [
+        Culling::None,
+        Culling::Face(wgpu::Face::Front),
+        Culling::Face(wgpu::Face::Back),
+    ];
+
+    fn face(self) -> Option<wgpu::Face> {
+        match self {
+            Culling::None => None,
+            Culling::Face(face) => Some(face),
+        }
+    }
+
+    fn index(self) -> usize {
+        match self {
+            Culling::None => 0,
+            Culling::Face(wgpu::Face::Front) => 1,
+            Culling::Face(wgpu::Face::Back) => 2,
+        }
+    }
+}
+
+/// A closed virtual object as the shadow passes see it now.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CasterFacing {
+    /// +1 when its triangles wind counter-clockwise seen from outside in the world frame (a
+    /// [`Closure::Outward`](crate::scene_geometry::Closure) object placed without a mirror, or
+    /// an inward one placed with one), -1 when clockwise.
+    pub orientation: f32,
+    /// Its bounding sphere now (world frame): a point light inside it sees its inside, and
+    /// draws every triangle.
+    pub sphere: (Vec3, f32),
+}
+
+/// The sign of the determinant of every directional light's map from world to (x, y, depth)
+/// (`ShadowProjection`): its rows are the light frame's u and v and minus its w (towards the
+/// light; depth grows away from it), all scaled by positive factors, and u x v = w.
+pub const DIRECTIONAL_HANDEDNESS: f32 = -1.0;
+
+/// The sign of the determinant of point-light cube face `face`'s map from world offsets to (x,
+/// y, z) (`face_coords`: an even permutation of the axes, times the face's sign on its axis, +1
+/// on the even faces and -1 on the odd ones); the perspective division by z > 0 keeps it.
+pub fn face_handedness(face: usize) -> f32 {
+    if face.is_multiple_of(2) { 1.0 } else { -1.0 }
+}
+
+/// The side of a caster's triangles to cull so that those facing the light are drawn, for a
+/// caster of `orientation` (+1: counter-clockwise seen from outside) and a projection whose
+/// map from world to (x, y, depth), depth growing away from the light, has a determinant of
+/// sign `handedness`. A triangle facing the light has its outward normal towards decreasing
+/// depth; through a map of positive determinant its corners, seen with x right and y up, run
+/// clockwise when it winds counter-clockwise from outside, and counter-clockwise through a
+/// negative one. wgpu (`FrontFace::Ccw`) calls counter-clockwise in normalised device
+/// coordinates the front, so the light-facing triangles are the front, and the back is culled,
+/// when `orientation x handedness < 0`; otherwise they are the back and the front is culled.
+pub fn away_facing(orientation: f32, handedness: f32) -> wgpu::Face {
+    if orientation * handedness < 0.0 {
+        wgpu::Face::Back
+    } else {
+        wgpu::Face::Front
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_handedness_of_each_projection_is_its_determinants_sign() {
+        // Directional: the light frame about many directions, any centre and extents.
+        for k in 0..64 {
+            let t = k as f32 * 0.7;
+            let w = Vec3::new(t.cos() * (0.3 * t).sin(), (0.3 * t).cos(), t.sin()).normalize();
+            let p = ShadowProjection::new(w, Vec3::new(1.0, -2.0, 3.0), 0.5 + t, 2.0, 0.1 * t);
+            let det = glam::Mat3::from_mat4(p.map_from_world).determinant();
+            assert_eq!(det.signum(), DIRECTIONAL_HANDEDNESS, "light towards {w}");
+        }
+        // Cube faces: face_coords of the three axes.
+        for face in 0..FACES {
+            let m = glam::Mat3::from_cols(
+                crate::point_lights::face_coords(Vec3::X, face),
+                crate::point_lights::face_coords(Vec3::Y, face),
+                crate::point_lights::face_coords(Vec3::Z, face),
+            );
+            assert_eq!(m.determinant(), face_handedness(face), "face {face}");
+        }
+        // A counter-clockwise (from outside) caster keeps its front through a map that turns
+        // it over, its back through one that does not; a clockwise one the other way.
+        assert_eq!(away_facing(1.0, -1.0), wgpu::Face::Back);
+        assert_eq!(away_facing(1.0, 1.0), wgpu::Face::Front);
+        assert_eq!(away_facing(-1.0, -1.0), wgpu::Face::Front);
+    }
 
     #[test]
     fn the_region_holds_small_moves_only() {

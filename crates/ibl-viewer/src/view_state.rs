@@ -437,6 +437,7 @@ impl Content {
                     shadow_tile: s.shadow_tile,
                     selected: s.selected,
                     light_culling: true,
+                    shadow_culling: true,
                 };
                 s.renderer.render(gpu, &s.model, &settings);
                 let _ = s.renderer.read_pass_times(gpu, false);
