@@ -151,12 +151,16 @@ fn cs_light_tiles(@builtin(global_invocation_id) id: vec3<u32>) {
         }
     }
     let base = light_mask_base(id.xy, size.x);
-    let count = frame.counts.x;
+    // Each word's loop runs over the lights it holds, and none in a tile without real samples:
+    // on lavapipe a light tested under a condition that differs between tiles costs its whole
+    // test even where the condition fails, while a loop stops at the last trip any tile takes.
+    let count = select(0u, frame.counts.x, real);
     for (var w = 0u; w < LIGHT_WORDS; w = w + 1u) {
         var bits = 0u;
-        for (var k = 0u; k < 32u; k = k + 1u) {
-            let i = w * 32u + k;
-            if real && i < count && faces(i, normals_lo, normals_hi) && reaches(i, lo, hi) {
+        let first = w * 32u;
+        let n = min(count - min(count, first), 32u);
+        for (var k = 0u; k < n; k = k + 1u) {
+            if faces(first + k, normals_lo, normals_hi) && reaches(first + k, lo, hi) {
                 bits = bits | (1u << k);
             }
         }
@@ -164,14 +168,16 @@ fn cs_light_tiles(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     // A point light already in the background changes a real surface only by the objects'
     // shadow; a new one by all its light.
-    let points = frame.counts.y;
+    let points = select(0u, frame.counts.y, real);
     let centre = 0.5 * (lo + hi);
     let radius = 0.5 * length(hi - lo);
     for (var w = 0u; w < POINT_LIGHT_WORDS; w = w + 1u) {
         var bits = 0u;
-        for (var b = 0u; b < 32u; b = b + 1u) {
-            let k = w * 32u + b;
-            if real && k < points && faces_point(k, lo, hi, normals_lo, normals_hi)
+        let first = w * 32u;
+        let n = min(points - min(points, first), 32u);
+        for (var b = 0u; b < n; b = b + 1u) {
+            let k = first + b;
+            if faces_point(k, lo, hi, normals_lo, normals_hi)
                 && (point_lights[k].shadow.z < 0.5 || point_shadow_reaches(k, centre, radius)) {
                 bits = bits | (1u << b);
             }
