@@ -186,6 +186,11 @@ pub struct ViewArgs {
     /// measuring what it saves).
     #[arg(long)]
     pub no_shadow_culling: bool,
+    /// Draw the virtual objects' full meshes into the shadow maps instead of their coarser
+    /// copies where those lie within half a texel (slower; for checking the copies or
+    /// measuring what they save).
+    #[arg(long)]
+    pub no_shadow_levels: bool,
     /// Camera yaw over a probe, degrees (0 looks along -Z, positive looks left).
     #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
     pub yaw: Option<f32>,
@@ -308,6 +313,7 @@ pub fn run(args: &ViewArgs, progress: &dyn Progress) -> Result<Option<ViewSummar
             sky_lights: args.sky_lights as usize,
             light_culling: !args.no_light_culling,
             shadow_culling: !args.no_shadow_culling,
+            shadow_levels: !args.no_shadow_levels,
         },
         exposure_stops: args.exposure,
         curve: ToneCurve::from(args.tonemap),

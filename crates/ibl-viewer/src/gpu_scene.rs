@@ -172,6 +172,22 @@ pub struct MeshBuffer {
     pub index_buffer: wgpu::Buffer,
     /// How many indices.
     pub indices: u32,
+    /// Its levels for the shadow passes, finest first (`shadow_lod.rs`); level 0 is the mesh
+    /// itself and draws from `index_buffer`. Only the virtual objects have more than one.
+    pub shadow_levels: Vec<ShadowLevel>,
+}
+
+/// One level of a mesh for the shadow passes on the GPU.
+#[derive(Debug)]
+pub struct ShadowLevel {
+    /// Its indices (`None` for level 0: the mesh's own).
+    pub index_buffer: Option<wgpu::Buffer>,
+    /// How many indices.
+    pub indices: u32,
+    /// How far its surface lies from the mesh's, load-frame units (meshoptimizer's estimate).
+    pub deviation: f32,
+    /// Whether it closes a volume.
+    pub closure: crate::scene_geometry::Closure,
 }
 
 impl MeshBuffer {
@@ -189,6 +205,26 @@ impl MeshBuffer {
     /// Draws every triangle as `instances` (after [`MeshBuffer::bind`]).
     pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>, instances: std::ops::Range<u32>) {
         pass.draw_indexed(0..self.indices, 0, instances);
+    }
+
+    /// Draws shadow level `level` as `instances`, binding its indices (after
+    /// [`MeshBuffer::bind`], whose vertex buffer every level shares).
+    pub fn draw_level(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        level: usize,
+        instances: std::ops::Range<u32>,
+    ) {
+        let level = &self.shadow_levels[level.min(self.shadow_levels.len() - 1)];
+        let buffer = level.index_buffer.as_ref().unwrap_or(&self.index_buffer);
+        pass.set_index_buffer(buffer.slice(..), wgpu::IndexFormat::Uint32);
+        pass.draw_indexed(0..level.indices, 0, instances);
+    }
+
+    /// The level to draw into a shadow map whose texels are `texel` world units wide at the
+    /// mesh, placed with its largest stretch `scale` (`shadow_lod::level_for`).
+    pub fn level_for(&self, texel: f32, scale: f32) -> usize {
+        crate::shadow_lod::level_for(self.shadow_levels.iter().map(|l| l.deviation), texel, scale)
     }
 }
 
@@ -217,9 +253,21 @@ pub struct GpuScene {
     pub caster_cells: wgpu::Buffer,
 }
 
-fn mesh(gpu: &GpuContext, label: &str, vertices: &[crate::scene_geometry::Vertex]) -> MeshBuffer {
+/// The buffers of a mesh given as three vertices per triangle; with its simplified copies for
+/// the shadow passes when `shadow_copies` (the virtual objects).
+fn mesh(
+    gpu: &GpuContext,
+    label: &str,
+    vertices: &[crate::scene_geometry::Vertex],
+    shadow_copies: bool,
+) -> MeshBuffer {
     let (kept, indices) = crate::scene_geometry::shared_vertices(vertices);
     let count = indices.len() as u32;
+    let levels = if shadow_copies {
+        crate::shadow_lod::shadow_lods(&kept, &indices)
+    } else {
+        Vec::new()
+    };
     // wgpu refuses empty buffers: one degenerate vertex and triangle stand in (never drawn).
     let (kept, indices) = if kept.is_empty() {
         (vec![crate::scene_geometry::Vertex::zeroed()], vec![0; 3])
@@ -234,6 +282,24 @@ fn mesh(gpu: &GpuContext, label: &str, vertices: &[crate::scene_geometry::Vertex
                 usage,
             })
     };
+    let mut shadow_levels = vec![ShadowLevel {
+        index_buffer: None,
+        indices: count,
+        deviation: 0.0,
+        closure: levels
+            .first()
+            .map_or(crate::scene_geometry::Closure::Open, |l| l.closure),
+    }];
+    shadow_levels.extend(levels.iter().skip(1).map(|l| ShadowLevel {
+        index_buffer: Some(init(
+            bytemuck::cast_slice(&l.indices),
+            wgpu::BufferUsages::INDEX,
+            "shadow level",
+        )),
+        indices: l.indices.len() as u32,
+        deviation: l.deviation,
+        closure: l.closure,
+    }));
     MeshBuffer {
         buffer: init(
             bytemuck::cast_slice(&kept),
@@ -246,6 +312,7 @@ fn mesh(gpu: &GpuContext, label: &str, vertices: &[crate::scene_geometry::Vertex
             "indices",
         ),
         indices: count,
+        shadow_levels,
     }
 }
 
@@ -290,11 +357,11 @@ impl GpuScene {
                 .map(|_| GpuObject::new(Affine3A::IDENTITY, true, false)),
         );
         GpuScene {
-            real: mesh(gpu, "real geometry", &geometry.real.vertices),
+            real: mesh(gpu, "real geometry", &geometry.real.vertices, false),
             objects: geometry
                 .objects
                 .iter()
-                .map(|o| mesh(gpu, &o.name, &o.vertices))
+                .map(|o| mesh(gpu, &o.name, &o.vertices, true))
                 .collect(),
             materials: storage(gpu, "materials", bytemuck::cast_slice(&materials)),
             transforms: storage(gpu, "objects", bytemuck::cast_slice(&transforms)),

@@ -64,6 +64,9 @@ pub struct HeadlessOptions {
     /// Closed objects' away-facing triangles left out of the shadow maps
     /// ([`SceneFrameSettings::shadow_culling`]).
     pub shadow_culling: bool,
+    /// Coarser copies of the objects in the shadow maps
+    /// ([`SceneFrameSettings::shadow_levels`]).
+    pub shadow_levels: bool,
 }
 
 impl Default for HeadlessOptions {
@@ -79,6 +82,7 @@ impl Default for HeadlessOptions {
             sky_lights: 0,
             light_culling: true,
             shadow_culling: true,
+            shadow_levels: true,
         }
     }
 }
@@ -294,6 +298,7 @@ pub fn render_scene_lit(
             selected: None,
             light_culling: options.light_culling,
             shadow_culling: options.shadow_culling,
+            shadow_levels: options.shadow_levels,
         };
         let started = Instant::now();
         let report = renderer.render(gpu, &moving, &settings);
@@ -350,6 +355,7 @@ pub fn render_sequence(
         selected: None,
         light_culling: options.light_culling,
         shadow_culling: options.shadow_culling,
+        shadow_levels: options.shadow_levels,
     };
     let frames = options.frames.max(1) as usize;
     let mut timings = Vec::with_capacity(frames);

@@ -76,6 +76,7 @@ pub mod sequence_panel;
 pub mod sequence_player;
 pub mod sequence_state;
 pub mod shadow_atlas;
+pub mod shadow_lod;
 pub mod textures;
 pub mod timing;
 pub mod view_camera;

@@ -20,7 +20,7 @@ use crate::gpu_scene::{FrameUniform, GpuLight, GpuObject, GpuScene, mat3_columns
 use crate::lighting::SceneLighting;
 use crate::scene_model::SceneModel;
 use crate::scene_pass::{SceneBindGroups, ScenePass, ScenePassInputs, ShaderVariant};
-use crate::shadow_atlas::{CasterFacing, ShadowAtlases};
+use crate::shadow_atlas::{CasterPlacement, ShadowAtlases, ShadowDrawing};
 use crate::textures::{HdrTexture, black_texture, upload_hdr};
 use crate::timing::{PassTimer, PassTimes, SCENE_PASSES};
 use crate::view_camera::OutputCamera;
@@ -58,6 +58,10 @@ pub struct SceneFrameSettings {
     /// Closed virtual objects draw only their light-facing triangles into the shadow maps
     /// (`shadow_atlas.rs`; the same atlas, faster); false draws every triangle (for checking).
     pub shadow_culling: bool,
+    /// Virtual objects draw coarser copies of themselves into shadow maps whose texels are much
+    /// larger than the difference (`shadow_lod.rs`; within half a texel, faster); false
+    /// draws the full meshes (for checking).
+    pub shadow_levels: bool,
 }
 
 /// What a frame did.
@@ -480,9 +484,26 @@ impl SceneRenderer {
         }
         if draw_virtual && any_lights {
             let t = self.timer.as_mut().and_then(|t| t.writes(1));
-            let facings = caster_facings(model, settings.shadow_culling);
-            self.shadows
-                .draw_virtual(gpu, &mut encoder, &self.gpu_scene, count, &facings, t);
+            let drawing = ShadowDrawing {
+                culling: settings.shadow_culling,
+                levels: settings.shadow_levels,
+            };
+            // The directional tiles' finest texel at the objects.
+            let texel = self
+                .gpu_lights
+                .iter()
+                .map(|l| l.virtual_extent[2])
+                .fold(f32::INFINITY, f32::min);
+            self.shadows.draw_virtual(
+                gpu,
+                &mut encoder,
+                &self.gpu_scene,
+                count,
+                &caster_placements(model),
+                drawing,
+                texel,
+                t,
+            );
         }
         {
             let t = self.timer.as_mut().and_then(|t| t.split_writes(2));
@@ -539,19 +560,23 @@ impl SceneRenderer {
     }
 }
 
-/// Per virtual object of `model`, how the shadow passes may cull its triangles now: a closed
-/// object's winding in the world frame (its closure's, turned over by a mirroring placement) and
-/// its bounding sphere; `None` for an open one, or for every object when `culling` is off.
-fn caster_facings(model: &SceneModel, culling: bool) -> Vec<Option<CasterFacing>> {
+/// Every virtual object of `model` as the shadow passes see it now: the sign of its placement's
+/// determinant, its largest stretch and its bounding sphere.
+fn caster_placements(model: &SceneModel) -> Vec<CasterPlacement> {
     (0..model.object_count())
         .map(|i| {
-            let winding = model.geometry.objects[i].closure.sign()?;
-            let mirror = model.world_from_load(i).matrix3.determinant().signum();
-            let (lo, hi) = model.object_box(i)?;
-            culling.then(|| CasterFacing {
-                orientation: winding * mirror,
+            let m = model.world_from_load(i).matrix3;
+            let (lo, hi) = model.object_box(i).unwrap_or((Vec3::ZERO, Vec3::ZERO));
+            CasterPlacement {
+                mirror: if m.determinant() < 0.0 { -1.0 } else { 1.0 },
+                scale: m
+                    .x_axis
+                    .length()
+                    .max(m.y_axis.length())
+                    .max(m.z_axis.length()),
                 sphere: crate::light_space::bounding_sphere(lo, hi),
-            })
+                bounds: (lo, hi),
+            }
         })
         .collect()
 }

@@ -50,7 +50,7 @@ use crate::gpu_scene::{
     FACES, GpuLight, GpuPointLight, GpuScene, MAX_POINT_LIGHTS, MeshBuffer, vec4,
 };
 use crate::light_space::{AtlasLayout, ShadowProjection, bounding_sphere, box_depths};
-use crate::point_lights::{FaceCasters, PointLightInputs, gpu_point_lights};
+use crate::point_lights::{FaceCasters, PointLightInputs, face_coords, gpu_point_lights};
 use crate::scene_geometry::{VERTEX_ATTRIBUTES, Vertex};
 
 /// The virtual atlas's depth format in a scene without point lights (module notes).
@@ -457,29 +457,61 @@ impl ShadowAtlases {
 
     /// Draws one caster (`object` 0 the real geometry, `k + 1` virtual object k, its `mesh`
     /// bound) into every point-light face of `atlas` that `faces` gives a tile, the viewport set
-    /// to the tile; a closed caster (`facing`) without its triangles facing away from the
-    /// light, unless the light stands inside its bounding sphere.
+    /// to the tile. A virtual object (`placed`) is drawn at the level its distance from the
+    /// light allows and, when that level is closed, without its triangles facing away from the
+    /// light; every triangle of the full mesh where the light stands inside its bounding sphere.
     fn draw_faces(
         &self,
         pass: &mut wgpu::RenderPass<'_>,
         atlas: &Atlas,
         object: u32,
         mesh: &MeshBuffer,
-        facing: Option<CasterFacing>,
+        placed: Option<(&CasterPlacement, ShadowDrawing)>,
         faces: impl Fn(&GpuPointLight) -> [[f32; 4]; FACES],
     ) {
         let (w, h) = atlas.size();
         let mut bound = None;
         for (k, light) in self.points.iter().enumerate() {
             let position = Vec3::new(light.position[0], light.position[1], light.position[2]);
-            let orientation = facing
-                .filter(|f| position.distance(f.sphere.0) > f.sphere.1)
-                .map(|f| f.orientation);
+            // Where the light is outside the object: per face, the level and the object's
+            // winding in the world.
+            let drawn = placed.and_then(|(p, drawing)| {
+                let (centre, radius) = p.sphere;
+                (position.distance(centre) > radius).then(|| {
+                    std::array::from_fn::<_, FACES, _>(|f| {
+                        // A face's texel at depth z along its axis is 2 z / texels wide, and
+                        // the object lies no nearer along it than its box's nearest corner.
+                        let (lo, hi) = p.bounds;
+                        let depth = (0..8)
+                            .map(|c| {
+                                let corner = Vec3::select(
+                                    glam::BVec3::new(c & 1 != 0, c & 2 != 0, c & 4 != 0),
+                                    hi,
+                                    lo,
+                                );
+                                face_coords(corner - position, f).z
+                            })
+                            .fold(f32::INFINITY, f32::min);
+                        let texel = 2.0 * depth.max(0.0) / light.shadow[1].max(1.0);
+                        let level = if drawing.levels {
+                            mesh.level_for(texel, p.scale)
+                        } else {
+                            0
+                        };
+                        let winding = mesh.shadow_levels[level].closure.sign();
+                        (
+                            level,
+                            winding.filter(|_| drawing.culling).map(|s| s * p.mirror),
+                        )
+                    })
+                })
+            });
             for (f, tile) in faces(light).iter().enumerate() {
                 if tile[2] == 0.0 {
                     continue;
                 }
-                let culling = orientation.map_or(Culling::None, |o| {
+                let (level, winding) = drawn.map_or((0, None), |d| d[f]);
+                let culling = winding.map_or(Culling::None, |o| {
                     Culling::Face(away_facing(o, face_handedness(f)))
                 });
                 if bound != Some(culling) {
@@ -496,21 +528,25 @@ impl ShadowAtlases {
                 );
                 let instance =
                     (object * MAX_POINT_LIGHTS as u32 + k as u32) * FACES as u32 + f as u32;
-                mesh.draw(pass, instance..instance + 1);
+                mesh.draw_level(pass, level, instance..instance + 1);
             }
         }
     }
 
     /// Draws the virtual objects into the virtual atlas, all directional lights in one
-    /// instanced draw each, then the point lights' faces. `facings` has one entry per object
-    /// (`None`: draw every triangle, as for an open object).
+    /// instanced draw each, then the point lights' faces. `placements` has one entry per
+    /// object; `directional_texel` is the directional tiles' finest texel, world units (the
+    /// lights' `virtual_extent.z`).
+    #[allow(clippy::too_many_arguments)]
     pub fn draw_virtual(
         &self,
         gpu: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
         scene: &GpuScene,
         lights: u32,
-        facings: &[Option<CasterFacing>],
+        placements: &[CasterPlacement],
+        drawing: ShadowDrawing,
+        directional_texel: f32,
         timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
     ) {
         let bind_group = self.bind_group(gpu, scene);
@@ -523,27 +559,34 @@ impl ShadowAtlases {
         let (w, h) = self.virtual_objects.size();
         let lights = lights.min(self.capacity());
         pass.set_bind_group(0, &bind_group, &[]);
-        for (k, mesh) in scene.objects.iter().enumerate() {
+        for ((k, mesh), placement) in scene.objects.iter().enumerate().zip(placements) {
             if mesh.is_empty() {
                 continue;
             }
             let object = k as u32 + 1;
-            let facing = facings.get(k).copied().flatten();
             mesh.bind(&mut pass);
             if lights > 0 {
-                let culling = facing.map_or(Culling::None, |f| {
-                    Culling::Face(away_facing(f.orientation, DIRECTIONAL_HANDEDNESS))
-                });
+                let level = if drawing.levels {
+                    mesh.level_for(directional_texel, placement.scale)
+                } else {
+                    0
+                };
+                let winding = mesh.shadow_levels[level].closure.sign();
+                let culling = winding
+                    .filter(|_| drawing.culling)
+                    .map_or(Culling::None, |s| {
+                        Culling::Face(away_facing(s * placement.mirror, DIRECTIONAL_HANDEDNESS))
+                    });
                 pass.set_pipeline(&self.virtual_pipelines[culling.index()]);
                 pass.set_viewport(0.0, 0.0, w as f32, h as f32, 0.0, 1.0);
-                mesh.draw(&mut pass, object * lights..(object + 1) * lights);
+                mesh.draw_level(&mut pass, level, object * lights..(object + 1) * lights);
             }
             self.draw_faces(
                 &mut pass,
                 &self.virtual_objects,
                 object,
                 mesh,
-                facing,
+                Some((placement, drawing)),
                 |p| p.virtual_faces,
             );
         }
@@ -582,16 +625,28 @@ impl Culling {
     }
 }
 
-/// A closed virtual object as the shadow passes see it now.
+/// A virtual object as the shadow passes see it now.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct CasterFacing {
-    /// +1 when its triangles wind counter-clockwise seen from outside in the world frame (a
-    /// [`Closure::Outward`](crate::scene_geometry::Closure) object placed without a mirror, or
-    /// an inward one placed with one), -1 when clockwise.
-    pub orientation: f32,
-    /// Its bounding sphere now (world frame): a point light inside it sees its inside, and
-    /// draws every triangle.
+pub struct CasterPlacement {
+    /// -1 when its placement mirrors it (its determinant is negative: a winding counter-clockwise
+    /// from outside at load is clockwise now), else +1.
+    pub mirror: f32,
+    /// Its placement's largest stretch: a load-frame length times at most this in the world.
+    pub scale: f32,
+    /// Its bounding sphere now (world frame): a point light inside it sees its inside, and draws
+    /// every triangle of the full mesh.
     pub sphere: (Vec3, f32),
+    /// Its world box now, `(min, max)`: how near a light's face it comes.
+    pub bounds: (Vec3, Vec3),
+}
+
+/// What the virtual shadow passes may leave out (both by default; off to check them).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ShadowDrawing {
+    /// A closed level's triangles facing away from the light ([`away_facing`]).
+    pub culling: bool,
+    /// The full mesh where a coarser copy is within half a texel (`shadow_lod.rs`).
+    pub levels: bool,
 }
 
 /// The sign of the determinant of every directional light's map from world to (x, y, depth)

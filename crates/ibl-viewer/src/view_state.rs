@@ -438,6 +438,7 @@ impl Content {
                     selected: s.selected,
                     light_culling: true,
                     shadow_culling: true,
+                    shadow_levels: true,
                 };
                 s.renderer.render(gpu, &s.model, &settings);
                 let _ = s.renderer.read_pass_times(gpu, false);

@@ -2,12 +2,14 @@
 //! (`shadow_atlas.rs`, `away_facing`), and the atlas is the one every triangle draws: a ray from
 //! the light meets a closed surface first through a triangle facing the light, rasterised the
 //! same way either way, so a texel keeps its depth bit for bit; except where a triangle facing
-//! away lies a rounding error in front of the facing one at a silhouette edge (measured: 1 to
-//! 11 texels in a million, by 2e-5 to 4.5e-4 of the depth range, under the look-up's smallest
-//! bias, about 1e-3 of it). So: no texel nearer the light with the culling than without, at
-//! most 1e-4 of the covered texels changed, none by more than 1e-3, and the frames the same. A
-//! wrong choice of the side to cull (the projection's handedness, a cube face's, the mesh's
-//! winding) keeps the far side's depths instead, and changes most texels the object covers. Checked on the
+//! away lies a rounding error in front of the facing one at a silhouette edge (measured: 7 to
+//! 13 texels in a million on the full bunny, up to 160 in a million on the coarser copies the
+//! room's cube faces take, whose larger triangles graze more; by 6e-8 to 4.5e-4 of the depth
+//! range, under the look-up's smallest bias, about 1e-3 of it). So: no texel nearer the light
+//! with the culling than without, at most 1e-3 of the covered texels changed, none by more
+//! than 1e-3, and the frames the same. A wrong choice of the side to cull (the projection's
+//! handedness, a cube face's, the mesh's winding) keeps the far side's depths instead, and
+//! changes most texels the object covers. Checked on the
 //! directional lights' tiles (bunny-sky, 16-bit atlas), on point lights' cube faces of both
 //! handedness (the room's 32 patches about the bunny; the umbrella luminaire over the bunny),
 //! with the bunny as loaded and turned and moved.
@@ -44,6 +46,7 @@ fn atlas(
         selected: None,
         light_culling: true,
         shadow_culling: culling,
+        shadow_levels: true,
     };
     renderer.render(gpu, model, &settings);
     let (w, h, texels) = renderer.virtual_atlas_texels(gpu).expect("reads the atlas");
@@ -88,7 +91,7 @@ fn same_atlas(name: &str, gpu: &GpuContext, model: &SceneModel, lighting: &Scene
         "{name}: culling triangles brought {nearer} texels nearer"
     );
     assert!(
-        differ as f64 <= 1e-4 * covered as f64,
+        differ as f64 <= 1e-3 * covered as f64,
         "{name}: the culled atlas differs on {differ} of {covered} texels"
     );
     assert!(largest <= 1e-3, "{name}: a texel moved by {largest}");
