@@ -41,7 +41,8 @@ pub struct FrameUniform {
     pub occluder: [f32; 4],
     /// Their mean diffuse albedo.
     pub occluder_albedo: [f32; 4],
-    /// The virtual objects' bounding sphere (centre, radius; radius 0 without objects).
+    /// A sphere holding the virtual objects' vertices (`SceneModel::casters_sphere`; radius 0
+    /// without objects).
     pub objects_sphere: [f32; 4],
 }
 

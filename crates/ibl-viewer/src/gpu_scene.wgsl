@@ -31,8 +31,9 @@ struct Frame {
     // `occluder_change`); zero when the scene has none.
     occluder: vec4<f32>,
     occluder_albedo: vec4<f32>,
-    // The virtual objects' bounding sphere (centre, radius): what the point lights' virtual
-    // faces are fitted to (light_tiles.wgsl's `point_shadow_reaches`); radius 0 without objects.
+    // A sphere holding every vertex of the virtual objects (centre, radius; SceneModel's
+    // casters_sphere): all the point lights' virtual faces hold lies in its cone from each light
+    // (light_tiles.wgsl's `point_shadow_reaches`); radius 0 without objects.
     objects_sphere: vec4<f32>,
 };
 

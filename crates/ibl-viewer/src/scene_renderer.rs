@@ -352,7 +352,7 @@ impl SceneRenderer {
                 None => [0.0; 4],
             },
             objects_sphere: model
-                .objects_sphere()
+                .casters_sphere()
                 .map_or([0.0; 4], |(c, r)| [c.x, c.y, c.z, r]),
         }
     }

@@ -69,13 +69,22 @@ fn room_culled_equals_unculled(edits: &str, display: &str) {
     let path = dir.path().join(edits);
     std::fs::write(&path, text).expect("writes the edits file");
     let room = assets.join("rooms/apartment/room.toml");
-    let live = room_live(&room, &path, &Silent).expect("the live display");
+    let mut live = room_live(&room, &path, &Silent).expect("the live display");
     assert!(
         live.lighting.luminaires.len() >= 32,
         "{edits}: the 32 patches as point lights"
     );
     compare(
         &format!("{edits} ({display})"),
+        &gpu,
+        &live.model,
+        &live.lighting,
+    );
+    // Turned and moved: the shadow cones follow the objects' sphere.
+    live.model.rotate(0, 75.0);
+    live.model.translate(0, glam::Vec3::new(0.1, 0.0, -0.05));
+    compare(
+        &format!("{edits} ({display}), moved"),
         &gpu,
         &live.model,
         &live.lighting,
