@@ -16,10 +16,8 @@
 
 mod common;
 
-use ibl_pipeline::progress::Silent;
 use ibl_viewer::headless::{self, HeadlessOptions};
 use ibl_viewer::lighting::SceneLighting;
-use ibl_viewer::room_live::room_live;
 use ibl_viewer::scene_geometry::Closure;
 use ibl_viewer::scene_renderer::{GlossySource, SceneFrameSettings, SceneRenderer};
 use ibl_viewer::{SceneModel, gpu::GpuContext};
@@ -118,33 +116,15 @@ fn same_atlas(name: &str, gpu: &GpuContext, model: &SceneModel, lighting: &Scene
     assert_eq!(changed, 0, "{name}: the frame changed");
 }
 
-fn scene(name: &str) -> (SceneModel, SceneLighting) {
-    let path = common::assets().join("scenes").join(format!("{name}.toml"));
-    let model = SceneModel::open(&path).expect("the example scene opens");
-    let (lighting, _) = headless::lights_now(&model).expect("the scene's lights");
-    (model, lighting)
-}
-
-/// The same, with the bunny also turned about the vertical and moved along the ground.
-fn as_loaded_and_moved(
-    name: &str,
-    gpu: &GpuContext,
-    model: &mut SceneModel,
-    lighting: &SceneLighting,
-) {
-    same_atlas(name, gpu, model, lighting);
-    model.rotate(0, 75.0);
-    model.translate(0, glam::Vec3::new(0.1, 0.0, -0.05));
-    same_atlas(&format!("{name}, moved"), gpu, model, lighting);
-}
-
 #[test]
 fn directional_tiles_keep_their_depths() {
     let Some(gpu) = common::gpu_or_skip("directional_tiles_keep_their_depths") else {
         return;
     };
-    let (mut model, lighting) = scene("bunny-sky");
-    as_loaded_and_moved("bunny-sky", &gpu, &mut model, &lighting);
+    let (mut model, lighting) = common::example_scene("bunny-sky");
+    common::as_loaded_and_moved("bunny-sky", &mut model, |name, model| {
+        same_atlas(name, &gpu, model, &lighting)
+    });
 }
 
 #[test]
@@ -152,9 +132,11 @@ fn a_luminaires_cube_faces_keep_their_depths() {
     let Some(gpu) = common::gpu_or_skip("a_luminaires_cube_faces_keep_their_depths") else {
         return;
     };
-    let (mut model, lighting) = scene("lamp/bunny-lamp");
+    let (mut model, lighting) = common::example_scene("lamp/bunny-lamp");
     assert!(!lighting.luminaires.is_empty());
-    as_loaded_and_moved("bunny-lamp", &gpu, &mut model, &lighting);
+    common::as_loaded_and_moved("bunny-lamp", &mut model, |name, model| {
+        same_atlas(name, &gpu, model, &lighting)
+    });
 }
 
 #[test]
@@ -162,14 +144,10 @@ fn the_rooms_patch_faces_keep_their_depths() {
     let Some(gpu) = common::gpu_or_skip("the_rooms_patch_faces_keep_their_depths") else {
         return;
     };
-    let assets = common::assets();
-    let room = assets.join("rooms/apartment");
-    let mut live = room_live(
-        &room.join("room.toml"),
-        &room.join("edits-object.toml"),
-        &Silent,
-    )
-    .expect("the live display");
+    let mut live = common::room_with_bunny();
     assert!(live.lighting.luminaires.len() >= 32);
-    as_loaded_and_moved("the room", &gpu, &mut live.model, &live.lighting);
+    let lighting = live.lighting.clone();
+    common::as_loaded_and_moved("the room", &mut live.model, |name, model| {
+        same_atlas(name, &gpu, model, &lighting)
+    });
 }

@@ -12,10 +12,8 @@
 mod common;
 
 use ibl_core::{Image, Rgb};
-use ibl_pipeline::progress::Silent;
 use ibl_viewer::headless::{self, HeadlessOptions};
 use ibl_viewer::lighting::SceneLighting;
-use ibl_viewer::room_live::room_live;
 use ibl_viewer::{SceneModel, gpu::GpuContext};
 
 const SIZE: (u32, u32) = (320, 240);
@@ -70,26 +68,16 @@ fn same_frame(name: &str, gpu: &GpuContext, model: &SceneModel, lighting: &Scene
     assert!(share <= 0.001, "{name}: {changed} pixels changed");
 }
 
-fn moved(name: &str, gpu: &GpuContext, model: &mut SceneModel, lighting: &SceneLighting) {
-    same_frame(name, gpu, model, lighting);
-    model.rotate(0, 75.0);
-    model.translate(0, glam::Vec3::new(0.1, 0.0, -0.05));
-    same_frame(&format!("{name}, moved"), gpu, model, lighting);
-}
-
 #[test]
 fn the_rooms_frame_keeps_its_shadows_with_the_copies() {
     let Some(gpu) = common::gpu_or_skip("the_rooms_frame_keeps_its_shadows_with_the_copies") else {
         return;
     };
-    let room = common::assets().join("rooms/apartment");
-    let mut live = room_live(
-        &room.join("room.toml"),
-        &room.join("edits-object.toml"),
-        &Silent,
-    )
-    .expect("the live display");
-    moved("the room", &gpu, &mut live.model, &live.lighting);
+    let mut live = common::room_with_bunny();
+    let lighting = live.lighting.clone();
+    common::as_loaded_and_moved("the room", &mut live.model, |name, model| {
+        same_frame(name, &gpu, model, &lighting)
+    });
 }
 
 #[test]
@@ -97,8 +85,8 @@ fn the_lamps_frame_keeps_its_shadows_with_the_copies() {
     let Some(gpu) = common::gpu_or_skip("the_lamps_frame_keeps_its_shadows_with_the_copies") else {
         return;
     };
-    let path = common::assets().join("scenes/lamp/bunny-lamp.toml");
-    let mut model = SceneModel::open(&path).expect("the example scene opens");
-    let (lighting, _) = headless::lights_now(&model).expect("the scene's lights");
-    moved("bunny-lamp", &gpu, &mut model, &lighting);
+    let (mut model, lighting) = common::example_scene("lamp/bunny-lamp");
+    common::as_loaded_and_moved("bunny-lamp", &mut model, |name, model| {
+        same_frame(name, &gpu, model, &lighting)
+    });
 }

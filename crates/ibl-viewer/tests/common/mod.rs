@@ -78,3 +78,36 @@ pub fn against_cpu(
         .map_err(|e| e.to_string());
     (outcome, masks_equal)
 }
+
+/// An example scene (`assets/scenes/NAME.toml`) and its lights, as `ibl view` makes them.
+pub fn example_scene(name: &str) -> (ibl_viewer::SceneModel, ibl_viewer::lighting::SceneLighting) {
+    let path = assets().join("scenes").join(format!("{name}.toml"));
+    let model = ibl_viewer::SceneModel::open(&path).expect("the example scene opens");
+    let (lighting, _) = ibl_viewer::headless::lights_now(&model).expect("the scene's lights");
+    (model, lighting)
+}
+
+/// The apartment's live display with the bundled bunny in the sun patch (`edits-object.toml`,
+/// improved display): the room as the real layer, its 32 important patches as point lights.
+pub fn room_with_bunny() -> ibl_viewer::room_live::RoomLive {
+    let room = assets().join("rooms/apartment");
+    ibl_viewer::room_live::room_live(
+        &room.join("room.toml"),
+        &room.join("edits-object.toml"),
+        &ibl_pipeline::progress::Silent,
+    )
+    .expect("the live display")
+}
+
+/// Runs `check(name, model)` on the scene as it is, then with its first object turned 75 degrees
+/// about the vertical and moved 0.1 m along x and -0.05 m along z (`NAME, moved`).
+pub fn as_loaded_and_moved(
+    name: &str,
+    model: &mut ibl_viewer::SceneModel,
+    check: impl Fn(&str, &ibl_viewer::SceneModel),
+) {
+    check(name, model);
+    model.rotate(0, 75.0);
+    model.translate(0, glam::Vec3::new(0.1, 0.0, -0.05));
+    check(&format!("{name}, moved"), model);
+}
