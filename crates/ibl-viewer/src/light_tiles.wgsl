@@ -74,14 +74,16 @@ fn faces(i: u32, lo: vec3<f32>, hi: vec3<f32>) -> bool {
 // the angle between the two axes is within the two half-angles and that margin, compared as
 // cosines (the sum of the three angles by the addition formulas; past pi, always); and always
 // when the light is inside either sphere.
-fn point_shadow_reaches(k: u32, centre: vec3<f32>, radius: f32) -> bool {
+// `reach` is the margin in radians and its cosine and sine (`point_reach`, the same for every
+// point light: their faces share the atlas's tile size).
+fn point_shadow_reaches(k: u32, centre: vec3<f32>, radius: f32, reach: vec3<f32>) -> bool {
     let objects = frame.objects_sphere;
     if objects.w <= 0.0 {
         // No objects: nothing in the virtual faces.
         return false;
     }
     let light = point_lights[k].position.xyz;
-    let margin = 12.0 / point_lights[k].shadow.y;
+    let margin = reach.x;
     let to_objects = objects.xyz - light;
     let d_objects = length(to_objects);
     let to_sphere = centre - light;
@@ -99,11 +101,18 @@ fn point_shadow_reaches(k: u32, centre: vec3<f32>, radius: f32) -> bool {
     let cos_spread = sqrt(max(1.0 - sin_spread * sin_spread, 0.0));
     let cos_both = cos_cone * cos_spread - sin_cone * sin_spread;
     let sin_both = sin_cone * cos_spread + cos_cone * sin_spread;
-    let cos_m = cos(margin);
-    let sin_m = sin(margin);
+    let cos_m = reach.y;
+    let sin_m = reach.z;
     let cos_all = cos_both * cos_m - sin_both * sin_m;
     let sin_all = sin_both * cos_m + cos_both * sin_m;
     return sin_all < 0.0 || dot(to_objects, to_sphere) >= cos_all * d_objects * d_sphere;
+}
+
+// The point lights' angular margin (12 texels of a face: `point_shadow_reaches`), its cosine and
+// sine.
+fn point_reach() -> vec3<f32> {
+    let margin = 12.0 / point_lights[0].shadow.y;
+    return vec3<f32>(margin, cos(margin), sin(margin));
 }
 
 // Whether some normal in the box (normals_lo, normals_hi) faces point light k from some point
@@ -171,6 +180,7 @@ fn cs_light_tiles(@builtin(global_invocation_id) id: vec3<u32>) {
     let points = select(0u, frame.counts.y, real);
     let centre = 0.5 * (lo + hi);
     let radius = 0.5 * length(hi - lo);
+    let reach = point_reach();
     for (var w = 0u; w < POINT_LIGHT_WORDS; w = w + 1u) {
         var bits = 0u;
         let first = w * 32u;
@@ -178,7 +188,7 @@ fn cs_light_tiles(@builtin(global_invocation_id) id: vec3<u32>) {
         for (var b = 0u; b < n; b = b + 1u) {
             let k = first + b;
             if faces_point(k, lo, hi, normals_lo, normals_hi)
-                && (point_lights[k].shadow.z < 0.5 || point_shadow_reaches(k, centre, radius)) {
+                && (point_lights[k].shadow.z < 0.5 || point_shadow_reaches(k, centre, radius, reach)) {
                 bits = bits | (1u << b);
             }
         }
