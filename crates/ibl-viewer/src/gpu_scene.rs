@@ -41,9 +41,6 @@ pub struct FrameUniform {
     pub occluder: [f32; 4],
     /// Their mean diffuse albedo.
     pub occluder_albedo: [f32; 4],
-    /// A sphere holding the virtual objects' vertices (`SceneModel::casters_sphere`; radius 0
-    /// without objects).
-    pub objects_sphere: [f32; 4],
 }
 
 /// `Light` of `gpu_scene.wgsl`.
@@ -93,6 +90,9 @@ pub struct GpuPointLight {
     pub real_faces: [[f32; 4]; FACES],
     /// Face tiles in the virtual atlas.
     pub virtual_faces: [[f32; 4]; FACES],
+    /// The cone from the light holding the virtual objects' vertices
+    /// (`point_lights::shadow_cone`).
+    pub shadow_cone: [f32; 4],
 }
 
 /// `Object` of `gpu_scene.wgsl`.
@@ -472,11 +472,11 @@ mod tests {
     #[test]
     fn structs_match_their_wgsl_sizes() {
         // Sums of the WGSL members (all 16-byte columns): no padding on either side.
-        assert_eq!(std::mem::size_of::<FrameUniform>(), 3 * 64 + 11 * 16);
+        assert_eq!(std::mem::size_of::<FrameUniform>(), 3 * 64 + 10 * 16);
         assert_eq!(std::mem::size_of::<GpuLight>(), 2 * 64 + 6 * 16);
         assert_eq!(std::mem::size_of::<GpuObject>(), 2 * 64 + 16);
         assert_eq!(std::mem::size_of::<GpuMaterial>(), 32);
-        assert_eq!(std::mem::size_of::<GpuPointLight>(), 64 + 16 * 15);
+        assert_eq!(std::mem::size_of::<GpuPointLight>(), 64 + 16 * 16);
         assert_eq!(std::mem::size_of::<crate::scene_geometry::Vertex>(), 28);
     }
 

@@ -31,10 +31,6 @@ struct Frame {
     // `occluder_change`); zero when the scene has none.
     occluder: vec4<f32>,
     occluder_albedo: vec4<f32>,
-    // A sphere holding every vertex of the virtual objects (centre, radius; SceneModel's
-    // casters_sphere): all the point lights' virtual faces hold lies in its cone from each light
-    // (light_tiles.wgsl's `point_shadow_reaches`); radius 0 without objects.
-    objects_sphere: vec4<f32>,
 };
 
 // Lights a frame draws (gpu_scene.rs's MAX_SHADOWED_LIGHTS): a uniform array of this many.
@@ -77,6 +73,11 @@ struct PointLight {
     // The six faces' tiles in each atlas (u0, v0, du, dv); du = 0 where the face sees no caster.
     real_faces: array<vec4<f32>, 6>,
     virtual_faces: array<vec4<f32>, 6>,
+    // The cone from the light holding every vertex of the virtual objects (point_lights.rs's
+    // shadow_cone): xyz its axis times the nearest vertex's distance, w the cosine of its
+    // half-angle; w = -2 where there is none (every direction: light_tiles.wgsl keeps the
+    // light everywhere), w = 2 where there are no objects (nowhere).
+    shadow_cone: vec4<f32>,
 };
 
 // Cube face `face` (0 +x, 1 -x, 2 +y, 3 -y, 4 +z, 5 -z) of vector v from a point light:

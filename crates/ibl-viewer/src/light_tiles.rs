@@ -1,8 +1,8 @@
 //! Light culling per screen tile for the real layer (`light_tiles.wgsl`): between the scene's
 //! geometry and shading passes, a compute pass marks, for each 8 x 8 pixel tile, the lights
 //! whose virtual-object shadow can reach the tile's real surfaces (a directional light against
-//! its caster cells, `caster_cells.rs`; a point light against the cone the objects' bounding
-//! sphere casts from it), and the new point lights that can light them. A real surface is
+//! its caster cells, `caster_cells.rs`; a point light against its cone about the objects'
+//! vertices, `point_lights::shadow_cone`), and the new point lights that can light them. A real surface is
 //! changed only by those lights (the composite's `with - without`, and a new light's whole
 //! light), so the shading pass loops over them alone; a virtual object still takes every
 //! light. The test is conservative: the frame is the same as with every light tested per

@@ -6,7 +6,7 @@
 // and the new point lights (their whole light is a change). A directional light is kept for a
 // tile when the box of the tile's real samples can see a caster through the shadow look-up
 // (`reaches`, against the light's caster cells), a point light already in the background when
-// the box's bounding sphere meets the cone of the objects' bounding sphere from it
+// the box's bounding sphere meets the light's cone about the objects' vertices
 // (`point_shadow_reaches`). Conservative, so the
 // composite is unchanged; the shading pass then loops over a tile's own lights, the same count
 // for every pixel of the tile, instead of testing every light per pixel.
@@ -63,49 +63,44 @@ fn faces(i: u32, lo: vec3<f32>, hi: vec3<f32>) -> bool {
 
 // Whether a sphere (centre, radius) can hold a point that point light k's virtual faces
 // shadow (point_lights.wgsl's `point_atlas_visibility`). The faces hold only the virtual
-// objects, which lie in their bounding sphere (frame.objects_sphere): a texel holds a caster
-// only where its centre's direction lies in the cone the sphere subtends from the light, and
-// only behind the sphere's nearest point. A look-up's direction strays from the receiver's by
-// its normal offset (at most 3.5 texels at the receiver's distance along the face's axis, a
-// texel being 2 / texels of the face's tangent plane: 7 / texels radians), the texel centres
-// its bilinear tap reads lie within a texel on each axis of it (2 sqrt(2) / texels) and its
-// clamp to the tile moves it by at most half a texel (1 / texels): under 11 / texels radians in
-// all, taken as 12, and 12 / texels of the distance besides. The sphere reaches the cone when
-// the angle between the two axes is within the two half-angles and that margin, compared as
-// cosines (the sum of the three angles by the addition formulas; past pi, always); and always
-// when the light is inside either sphere.
-// `reach` is the margin in radians and its cosine and sine (`point_reach`, the same for every
-// point light: their faces share the atlas's tile size).
+// objects, whose vertices, and so triangles, lie in the light's shadow cone (point_lights.rs's
+// `shadow_cone`, fitted on the CPU whenever an object or a light moves): a texel holds a caster
+// only where its centre's direction lies in that cone, and only behind its nearest vertex. A
+// look-up's direction strays from the receiver's by its normal offset (at most 3.5 texels at
+// the receiver's distance along the face's axis, a texel being 2 / texels of the face's tangent
+// plane: 7 / texels radians), the texel centres its bilinear tap reads lie within a texel on
+// each axis of it (2 sqrt(2) / texels) and its clamp to the tile moves it by at most half a
+// texel (1 / texels): under 11 / texels radians in all, taken as 12 (`reach`), and 12 / texels
+// of the distance besides. The sphere reaches the cone when the angle between the two axes is
+// within the two half-angles and that margin, compared as cosines (the sum of the three
+// angles by the addition formulas; past pi, always); and always when the light is inside the
+// sphere or the cone is a half-space or wider.
 fn point_shadow_reaches(k: u32, centre: vec3<f32>, radius: f32, reach: vec3<f32>) -> bool {
-    let objects = frame.objects_sphere;
-    if objects.w <= 0.0 {
+    let cone = point_lights[k].shadow_cone;
+    if cone.w > 1.5 {
         // No objects: nothing in the virtual faces.
         return false;
     }
     let light = point_lights[k].position.xyz;
-    let margin = reach.x;
-    let to_objects = objects.xyz - light;
-    let d_objects = length(to_objects);
     let to_sphere = centre - light;
     let d_sphere = length(to_sphere);
-    if d_objects <= objects.w || d_sphere <= radius {
+    if cone.w < -1.5 || d_sphere <= radius {
         return true;
     }
-    if (d_sphere + radius) * (1.0 + margin) < d_objects - objects.w {
+    let nearest = length(cone.xyz);
+    if (d_sphere + radius) * (1.0 + reach.x) < nearest {
         // The whole sphere is nearer the light than any caster.
         return false;
     }
-    let sin_cone = objects.w / d_objects;
-    let cos_cone = sqrt(max(1.0 - sin_cone * sin_cone, 0.0));
+    let cos_cone = cone.w;
+    let sin_cone = sqrt(max(1.0 - cos_cone * cos_cone, 0.0));
     let sin_spread = radius / d_sphere;
     let cos_spread = sqrt(max(1.0 - sin_spread * sin_spread, 0.0));
     let cos_both = cos_cone * cos_spread - sin_cone * sin_spread;
     let sin_both = sin_cone * cos_spread + cos_cone * sin_spread;
-    let cos_m = reach.y;
-    let sin_m = reach.z;
-    let cos_all = cos_both * cos_m - sin_both * sin_m;
-    let sin_all = sin_both * cos_m + cos_both * sin_m;
-    return sin_all < 0.0 || dot(to_objects, to_sphere) >= cos_all * d_objects * d_sphere;
+    let cos_all = cos_both * reach.y - sin_both * reach.z;
+    let sin_all = sin_both * reach.y + cos_both * reach.z;
+    return sin_all < 0.0 || dot(cone.xyz, to_sphere) >= cos_all * nearest * d_sphere;
 }
 
 // The point lights' angular margin (12 texels of a face: `point_shadow_reaches`), its cosine and

@@ -70,6 +70,36 @@ pub fn face_sees_sphere(light: Vec3, face: usize, centre: Vec3, radius: f32) -> 
     q.z > -radius && q.x - q.z < r && -q.x - q.z < r && q.y - q.z < r && -q.y - q.z < r
 }
 
+/// The narrowest cone about the direction from `light` to `centre` that holds every one of
+/// `points` (the virtual objects' vertices, so their triangles too, a cone under a half-turn
+/// being convex): `[axis x nearest distance, cos of the half-angle]`, what the light tiles test
+/// a tile's samples against (`light_tiles.wgsl`'s `point_shadow_reaches`; the objects' shadow
+/// from this light can fall only inside it, behind the nearest vertex). `w = -2` where no such
+/// cone is narrower than a half-space (the light at or among the objects), `w = 2` without
+/// points (no shadow anywhere). O(points).
+pub fn shadow_cone(light: Vec3, centre: Vec3, points: &[Vec3]) -> [f32; 4] {
+    if points.is_empty() {
+        return [0.0, 0.0, 0.0, 2.0];
+    }
+    let Some(axis) = (centre - light).try_normalize() else {
+        return [0.0, 0.0, 0.0, -2.0];
+    };
+    let (mut cos, mut nearest) = (1.0f32, f32::INFINITY);
+    for &p in points {
+        let v = p - light;
+        let d = v.length();
+        nearest = nearest.min(d);
+        if d > 0.0 {
+            cos = cos.min(v.dot(axis) / d);
+        }
+    }
+    if cos <= 0.0 || nearest <= 0.0 {
+        return [0.0, 0.0, 0.0, -2.0];
+    }
+    let a = axis * nearest;
+    [a.x, a.y, a.z, cos]
+}
+
 /// Near and far planes for casters in the sphere `(centre, radius)` seen from `light`: far
 /// just past its farthest point, near at 0.9 of its nearest (or `far / 10^4` when the light is
 /// inside it). With a 32-bit float depth `face_depth` resolves `z^2 / near x 2^-24` at distance
@@ -126,9 +156,11 @@ impl PointLightInputs<'static> {
 
 /// What the faces of a frame's point lights are fitted to.
 #[derive(Clone, Copy, Debug)]
-pub struct FaceCasters {
+pub struct FaceCasters<'a> {
     /// The virtual objects' bounding sphere.
     pub objects: (Vec3, f32),
+    /// Their distinct vertices, world frame (each light's [`shadow_cone`]).
+    pub points: &'a [Vec3],
     /// The real geometry's bounding sphere (none without real geometry).
     pub real: Option<(Vec3, f32)>,
 }
@@ -139,7 +171,7 @@ pub fn gpu_point_lights(
     inputs: &PointLightInputs<'_>,
     layout: &AtlasLayout,
     first_tile: u32,
-    casters: FaceCasters,
+    casters: FaceCasters<'_>,
 ) -> Vec<GpuPointLight> {
     let PointLightInputs {
         lights,
@@ -197,6 +229,7 @@ pub fn gpu_point_lights(
                 ],
                 real_faces,
                 virtual_faces,
+                shadow_cone: shadow_cone(p, objects_centre, casters.points),
             }
         })
         .collect()
@@ -259,6 +292,34 @@ mod tests {
             .filter(|&f| face_sees_sphere(light, f, side.0, side.1))
             .collect();
         assert_eq!(seen, vec![0, 3]);
+    }
+
+    #[test]
+    fn the_shadow_cone_holds_every_caster_and_no_more() {
+        let light = Vec3::new(0.0, 3.0, 0.0);
+        let points = [
+            Vec3::new(0.0, 1.0, 0.0),
+            Vec3::new(0.5, 0.0, 0.0),
+            Vec3::new(-0.5, 0.0, 0.0),
+            Vec3::new(0.0, 0.0, 0.25),
+        ];
+        let centre = Vec3::new(0.0, 0.5, 0.0);
+        let [x, y, z, cos] = shadow_cone(light, centre, &points);
+        let axis = Vec3::new(x, y, z);
+        // Straight down, 2 m to the nearest point; the widest point 0.5 m aside 3 m down.
+        assert!((axis.normalize() - Vec3::NEG_Y).length() < 1e-6);
+        assert!((axis.length() - 2.0).abs() < 1e-6);
+        let widest = 3.0 / 9.25f32.sqrt();
+        assert!((cos - widest).abs() < 1e-6, "{cos} against {widest}");
+        for p in points {
+            assert!((p - light).normalize().dot(axis.normalize()) >= cos - 1e-6);
+        }
+        // A light among the objects: no cone narrower than a half-space; none without objects.
+        assert_eq!(
+            shadow_cone(Vec3::new(0.0, 0.5, 0.0), centre, &points)[3],
+            -2.0
+        );
+        assert_eq!(shadow_cone(light, centre, &[])[3], 2.0);
     }
 
     #[test]

@@ -41,9 +41,9 @@ pub struct ObjectGeometry {
     pub bvh: Bvh,
     /// Axis-aligned bounds at load, `(min, max)`.
     pub bounds: (Vec3, Vec3),
-    /// A sphere holding every vertex at load, `(centre, radius)`: the bounds' centre and the
-    /// farthest vertex from it (the bunny's: 0.85 of the bounds' half diagonal).
-    pub sphere: (Vec3, f32),
+    /// Its distinct vertex positions at load (the point lights' shadow cones hold them all:
+    /// `point_lights::shadow_cone`).
+    pub points: Vec<Vec3>,
     /// Global material indices this object uses.
     pub materials: Range<u32>,
     /// Whether its triangles close a volume, and which way they wind (the shadow passes draw
@@ -196,17 +196,17 @@ fn object(name: String, vertices: Vec<Vertex>) -> ObjectGeometry {
     let (lo, hi) = vertices.iter().fold((u32::MAX, 0u32), |(lo, hi), v| {
         (lo.min(v.material), hi.max(v.material))
     });
-    let bounds = bounds_of(&vertices);
-    let centre = 0.5 * (bounds.0 + bounds.1);
-    let radius = vertices
+    let mut seen = std::collections::HashSet::with_capacity(vertices.len() / 4);
+    let points = vertices
         .iter()
-        .map(|v| Vec3::from(v.position).distance(centre))
-        .fold(0.0f32, f32::max);
+        .filter(|v| seen.insert(bytemuck::cast::<[f32; 3], [u32; 3]>(v.position)))
+        .map(|v| Vec3::from(v.position))
+        .collect();
     ObjectGeometry {
         name,
         closure: Closure::of(&vertices),
-        bounds,
-        sphere: (centre, radius),
+        bounds: bounds_of(&vertices),
+        points,
         bvh: Bvh::new(&corners),
         materials: if vertices.is_empty() {
             0..0

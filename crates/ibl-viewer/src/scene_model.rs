@@ -169,37 +169,18 @@ impl SceneModel {
         Some((lo, hi))
     }
 
-    /// A sphere holding every vertex of every virtual object as placed now (`None` without
-    /// objects): each object's own sphere at load (`ObjectGeometry::sphere`) moved with it, its
-    /// radius times the placement's largest stretch, and the sphere about their boxes' centre
-    /// that holds them all. Tighter than [`SceneModel::objects_sphere`] (which bounds the
-    /// objects' boxes), and unchanged as an object turns: the point lights' shadow cones
-    /// (`light_tiles.wgsl`).
-    pub fn casters_sphere(&self) -> Option<(Vec3, f32)> {
-        let spheres: Vec<(Vec3, f32)> = (0..self.geometry.objects.len())
-            .filter(|&i| !self.geometry.objects[i].vertices.is_empty())
-            .map(|i| {
+    /// Every distinct vertex of every virtual object as placed now, world frame (the point
+    /// lights' shadow cones: `point_lights::shadow_cone`).
+    pub fn caster_points(&self) -> Vec<Vec3> {
+        (0..self.geometry.objects.len())
+            .flat_map(|i| {
                 let m = self.world_from_load(i);
-                let (c, r) = self.geometry.objects[i].sphere;
-                let stretch = m
-                    .matrix3
-                    .x_axis
-                    .length()
-                    .max(m.matrix3.y_axis.length())
-                    .max(m.matrix3.z_axis.length());
-                (m.transform_point3(c), r * stretch)
+                self.geometry.objects[i]
+                    .points
+                    .iter()
+                    .map(move |&p| m.transform_point3(p))
             })
-            .collect();
-        let (lo, hi) = spheres.iter().fold(
-            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-            |(lo, hi), &(c, r)| (lo.min(c - r), hi.max(c + r)),
-        );
-        let centre = 0.5 * (lo + hi);
-        let radius = spheres
-            .iter()
-            .map(|&(c, r)| c.distance(centre) + r)
-            .reduce(f32::max)?;
-        Some((centre, radius))
+            .collect()
     }
 
     /// The bounding sphere of every virtual object as placed now (`None` without objects).

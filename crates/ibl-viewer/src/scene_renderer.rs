@@ -351,9 +351,6 @@ impl SceneRenderer {
                 }
                 None => [0.0; 4],
             },
-            objects_sphere: model
-                .casters_sphere()
-                .map_or([0.0; 4], |(c, r)| [c.x, c.y, c.z, r]),
         }
     }
 
@@ -441,11 +438,18 @@ impl SceneRenderer {
                 .map_or(crate::point_lights::PointLightInputs::NONE, |l| {
                     l.point_light_inputs(self.intensity.scale)
                 });
+            // The objects' vertices now, for the point lights' shadow cones.
+            let caster_points = if points.lights.is_empty() {
+                Vec::new()
+            } else {
+                model.caster_points()
+            };
             let (gpu_lights, region_moved) = self.shadows.fit(
                 lights,
                 &points,
                 model.description.lighting.shadows,
                 sphere,
+                &caster_points,
                 model.geometry.real_bounds(),
             );
             draw_real |= region_moved;

@@ -304,7 +304,8 @@ impl ShadowAtlases {
     }
 
     /// The GPU lights: each light's tiles fitted to the scene (see the module notes). `objects`
-    /// is the bounding sphere of the virtual objects now, `real_bounds` the real geometry's box.
+    /// is the bounding sphere of the virtual objects now, `caster_points` their distinct
+    /// vertices (the point lights' shadow cones), `real_bounds` the real geometry's box.
     /// The point lights' faces are fitted too (kept for drawing, [`Self::point_lights`]).
     /// Returns the directional lights and whether the real region moved (the real atlas must
     /// be redrawn).
@@ -314,10 +315,12 @@ impl ShadowAtlases {
         points: &PointLightInputs<'_>,
         shadows: ShadowKind,
         objects: (Vec3, f32),
+        caster_points: &[Vec3],
         real_bounds: Option<(Vec3, Vec3)>,
     ) -> (Vec<GpuLight>, bool) {
         let casters = FaceCasters {
             objects,
+            points: caster_points,
             real: real_bounds.map(|(lo, hi)| bounding_sphere(lo, hi)),
         };
         self.points = gpu_point_lights(points, &self.real.layout, lights.len() as u32, casters);
