@@ -102,18 +102,24 @@ pub fn bounding_sphere(lo: Vec3, hi: Vec3) -> (Vec3, f32) {
     ((lo + hi) * 0.5, ((hi - lo) * 0.5).length().max(1e-4))
 }
 
+/// The eight corners of the box `(lo, hi)`.
+pub fn box_corners(lo: Vec3, hi: Vec3) -> [Vec3; 8] {
+    std::array::from_fn(|k| {
+        Vec3::new(
+            if k & 1 == 0 { lo.x } else { hi.x },
+            if k & 2 == 0 { lo.y } else { hi.y },
+            if k & 4 == 0 { lo.z } else { hi.z },
+        )
+    })
+}
+
 /// Extents along `w` of the box `(lo, hi)` about `centre`: `(toward_light, away_from_light)`, the
 /// largest distances of its corners in front of and behind `centre` along `w` (at least 0).
 pub fn box_depths(w: Vec3, centre: Vec3, lo: Vec3, hi: Vec3) -> (f32, f32) {
     let w = w.normalize();
     let mut toward = 0.0f32;
     let mut away = 0.0f32;
-    for k in 0..8 {
-        let corner = Vec3::new(
-            if k & 1 == 0 { lo.x } else { hi.x },
-            if k & 2 == 0 { lo.y } else { hi.y },
-            if k & 4 == 0 { lo.z } else { hi.z },
-        );
+    for corner in box_corners(lo, hi) {
         let d = (corner - centre).dot(w);
         toward = toward.max(d);
         away = away.max(-d);

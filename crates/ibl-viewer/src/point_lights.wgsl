@@ -128,14 +128,7 @@ fn add_point_lights(m: Material, p: vec3<f32>, f: SurfaceFrame, wo: vec3<f32>, o
     let count = frame.counts.y;
     let words = (count + 31u) / 32u;
     for (var word = 0u; word < words; word = word + 1u) {
-        var bits = 0xffffffffu;
-        if TILED_LIGHTS && !on_virtual {
-            bits = light_masks[mask_base + LIGHT_WORDS + word];
-        }
-        let left = count - 32u * word;
-        if left < 32u {
-            bits = bits & ((1u << left) - 1u);
-        }
+        var bits = word_lights(count, word, on_virtual, mask_base + LIGHT_WORDS);
         // The lights of this word that change the pixel.
         var changing = 0u;
         loop {

@@ -46,9 +46,6 @@ pub struct ObjectGeometry {
     pub points: Vec<Vec3>,
     /// Global material indices this object uses.
     pub materials: Range<u32>,
-    /// Whether its triangles close a volume, and which way they wind (the shadow passes draw
-    /// only the light-facing triangles of a closed object: `shadow_atlas.rs`).
-    pub closure: Closure,
 }
 
 /// How an object's triangles bound a volume.
@@ -155,7 +152,8 @@ pub struct SceneGeometry {
     pub materials: Vec<Material>,
 }
 
-fn bounds_of(vertices: &[Vertex]) -> (Vec3, Vec3) {
+/// The box of `vertices`' positions, `(min, max)` (infinite and empty for no vertices).
+pub(crate) fn bounds_of(vertices: &[Vertex]) -> (Vec3, Vec3) {
     vertices.iter().fold(
         (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
         |(lo, hi), v| {
@@ -204,7 +202,6 @@ fn object(name: String, vertices: Vec<Vertex>) -> ObjectGeometry {
         .collect();
     ObjectGeometry {
         name,
-        closure: Closure::of(&vertices),
         bounds: bounds_of(&vertices),
         points,
         bvh: Bvh::new(&corners),

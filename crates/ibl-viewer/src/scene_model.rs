@@ -156,12 +156,7 @@ impl SceneModel {
         let (a, b) = g.bounds;
         let mut lo = Vec3::splat(f32::INFINITY);
         let mut hi = Vec3::splat(f32::NEG_INFINITY);
-        for k in 0..8 {
-            let corner = Vec3::new(
-                if k & 1 == 0 { a.x } else { b.x },
-                if k & 2 == 0 { a.y } else { b.y },
-                if k & 4 == 0 { a.z } else { b.z },
-            );
+        for corner in crate::light_space::box_corners(a, b) {
             let p = m.transform_point3(corner);
             lo = lo.min(p);
             hi = hi.max(p);

@@ -316,6 +316,21 @@ struct LightSums {
     affected: bool,
 };
 
+// The lights of mask word `word` (32 a word) of `count` that a surface takes: every one on a
+// virtual object, on a real surface those its screen tile's mask names, whose words start at
+// `first` (light_tiles.wgsl).
+fn word_lights(count: u32, word: u32, on_virtual: bool, first: u32) -> u32 {
+    var bits = 0xffffffffu;
+    if TILED_LIGHTS && !on_virtual {
+        bits = light_masks[first + word];
+    }
+    let left = count - 32u * word;
+    if left < 32u {
+        bits = bits & ((1u << left) - 1u);
+    }
+    return bits;
+}
+
 // One loop over the lights for both layers, so that the shadow look-ups are compiled once
 // (on lavapipe the size of the shader costs as much as the work it does: BENCHMARKS.md). A
 // virtual object takes every light; a real surface only those its screen tile's mask names
@@ -327,14 +342,7 @@ fn light_sums(m: Material, p: vec3<f32>, f: SurfaceFrame, wo: vec3<f32>, on_virt
     let count = frame.counts.x;
     let words = (count + 31u) / 32u;
     for (var word = 0u; word < words; word = word + 1u) {
-        var bits = 0xffffffffu;
-        if TILED_LIGHTS && !on_virtual {
-            bits = light_masks[mask_base + word];
-        }
-        let left = count - 32u * word;
-        if left < 32u {
-            bits = bits & ((1u << left) - 1u);
-        }
+        var bits = word_lights(count, word, on_virtual, mask_base);
         loop {
             if bits == 0u {
                 break;

@@ -565,7 +565,7 @@ impl SceneRenderer {
 }
 
 /// Every virtual object of `model` as the shadow passes see it now: the sign of its placement's
-/// determinant, its largest stretch and its bounding sphere.
+/// determinant, its largest stretch and its world box.
 fn caster_placements(model: &SceneModel) -> Vec<CasterPlacement> {
     (0..model.object_count())
         .map(|i| {
@@ -578,7 +578,6 @@ fn caster_placements(model: &SceneModel) -> Vec<CasterPlacement> {
                     .length()
                     .max(m.y_axis.length())
                     .max(m.z_axis.length()),
-                sphere: crate::light_space::bounding_sphere(lo, hi),
                 bounds: (lo, hi),
             }
         })

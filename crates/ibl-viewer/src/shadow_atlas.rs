@@ -49,7 +49,7 @@ use crate::gpu::{DEPTH_FORMAT, GpuContext};
 use crate::gpu_scene::{
     FACES, GpuLight, GpuPointLight, GpuScene, MAX_POINT_LIGHTS, MeshBuffer, vec4,
 };
-use crate::light_space::{AtlasLayout, ShadowProjection, bounding_sphere, box_depths};
+use crate::light_space::{AtlasLayout, ShadowProjection, bounding_sphere, box_corners, box_depths};
 use crate::point_lights::{FaceCasters, PointLightInputs, face_coords, gpu_point_lights};
 use crate::scene_geometry::{VERTEX_ATTRIBUTES, Vertex};
 
@@ -474,49 +474,31 @@ impl ShadowAtlases {
     ) {
         let (w, h) = atlas.size();
         let mut bound = None;
+        // The object's corners and bounding sphere now.
+        let placed = placed.map(|(p, drawing)| {
+            let (lo, hi) = p.bounds;
+            (p, drawing, box_corners(lo, hi), bounding_sphere(lo, hi))
+        });
         for (k, light) in self.points.iter().enumerate() {
             let position = Vec3::new(light.position[0], light.position[1], light.position[2]);
-            // Where the light is outside the object: per face, the level and the object's
-            // winding in the world.
-            let drawn = placed.and_then(|(p, drawing)| {
-                let (centre, radius) = p.sphere;
-                (position.distance(centre) > radius).then(|| {
-                    std::array::from_fn::<_, FACES, _>(|f| {
-                        // A face's texel at depth z along its axis is 2 z / texels wide, and
-                        // the object lies no nearer along it than its box's nearest corner.
-                        let (lo, hi) = p.bounds;
-                        let depth = (0..8)
-                            .map(|c| {
-                                let corner = Vec3::select(
-                                    glam::BVec3::new(c & 1 != 0, c & 2 != 0, c & 4 != 0),
-                                    hi,
-                                    lo,
-                                );
-                                face_coords(corner - position, f).z
-                            })
-                            .fold(f32::INFINITY, f32::min);
-                        let texel = 2.0 * depth.max(0.0) / light.shadow[1].max(1.0);
-                        let level = if drawing.levels {
-                            mesh.level_for(texel, p.scale)
-                        } else {
-                            0
-                        };
-                        let winding = mesh.shadow_levels[level].closure.sign();
-                        (
-                            level,
-                            winding.filter(|_| drawing.culling).map(|s| s * p.mirror),
-                        )
-                    })
-                })
-            });
+            // The object drawn whole where the light is inside it.
+            let outside =
+                placed.filter(|&(_, _, _, (centre, radius))| position.distance(centre) > radius);
             for (f, tile) in faces(light).iter().enumerate() {
                 if tile[2] == 0.0 {
                     continue;
                 }
-                let (level, winding) = drawn.map_or((0, None), |d| d[f]);
-                let culling = winding.map_or(Culling::None, |o| {
-                    Culling::Face(away_facing(o, face_handedness(f)))
-                });
+                let (level, culling) =
+                    outside.map_or((0, Culling::None), |(p, drawing, corners, _)| {
+                        // A face's texel at depth z along its axis is 2 z / texels wide, and the
+                        // object lies no nearer along it than its box's nearest corner.
+                        let depth = corners
+                            .iter()
+                            .map(|&c| face_coords(c - position, f).z)
+                            .fold(f32::INFINITY, f32::min);
+                        let texel = 2.0 * depth.max(0.0) / light.shadow[1].max(1.0);
+                        drawn_as(mesh, p, drawing, texel, face_handedness(f))
+                    });
                 if bound != Some(culling) {
                     pass.set_pipeline(&self.face_pipelines[culling.index()]);
                     bound = Some(culling);
@@ -569,17 +551,13 @@ impl ShadowAtlases {
             let object = k as u32 + 1;
             mesh.bind(&mut pass);
             if lights > 0 {
-                let level = if drawing.levels {
-                    mesh.level_for(directional_texel, placement.scale)
-                } else {
-                    0
-                };
-                let winding = mesh.shadow_levels[level].closure.sign();
-                let culling = winding
-                    .filter(|_| drawing.culling)
-                    .map_or(Culling::None, |s| {
-                        Culling::Face(away_facing(s * placement.mirror, DIRECTIONAL_HANDEDNESS))
-                    });
+                let (level, culling) = drawn_as(
+                    mesh,
+                    placement,
+                    drawing,
+                    directional_texel,
+                    DIRECTIONAL_HANDEDNESS,
+                );
                 pass.set_pipeline(&self.virtual_pipelines[culling.index()]);
                 pass.set_viewport(0.0, 0.0, w as f32, h as f32, 0.0, 1.0);
                 mesh.draw_level(&mut pass, level, object * lights..(object + 1) * lights);
@@ -594,6 +572,32 @@ impl ShadowAtlases {
             );
         }
     }
+}
+
+/// How a virtual object is drawn into a shadow map whose texels are `texel` world units wide at
+/// it, through a projection of handedness `handedness`: the level (the coarsest within half a
+/// texel, `shadow_lod.rs`) and, when that level is closed, its triangles facing away from the
+/// light culled ([`away_facing`]; the level's winding turned over by a mirroring placement).
+fn drawn_as(
+    mesh: &MeshBuffer,
+    placement: &CasterPlacement,
+    drawing: ShadowDrawing,
+    texel: f32,
+    handedness: f32,
+) -> (usize, Culling) {
+    let level = if drawing.levels {
+        mesh.level_for(texel, placement.scale)
+    } else {
+        0
+    };
+    let culling = mesh.shadow_levels[level]
+        .closure
+        .sign()
+        .filter(|_| drawing.culling)
+        .map_or(Culling::None, |s| {
+            Culling::Face(away_facing(s * placement.mirror, handedness))
+        });
+    (level, culling)
 }
 
 /// Which triangles a shadow pass leaves out.
@@ -636,10 +640,8 @@ pub struct CasterPlacement {
     pub mirror: f32,
     /// Its placement's largest stretch: a load-frame length times at most this in the world.
     pub scale: f32,
-    /// Its bounding sphere now (world frame): a point light inside it sees its inside, and draws
-    /// every triangle of the full mesh.
-    pub sphere: (Vec3, f32),
-    /// Its world box now, `(min, max)`: how near a light's face it comes.
+    /// Its world box now, `(min, max)`: how near a light's face it comes; a point light inside
+    /// its bounding sphere sees its inside, and draws every triangle of the full mesh.
     pub bounds: (Vec3, Vec3),
 }
 

@@ -13,9 +13,7 @@
 //! texel. The copies share the
 //! object's vertex buffer (index lists only); the full mesh is level 0.
 
-use glam::Vec3;
-
-use crate::scene_geometry::{Closure, Vertex};
+use crate::scene_geometry::{Closure, Vertex, bounds_of};
 
 /// How far a copy's surface may lie from the object's by meshoptimizer's estimate, in texels of
 /// the shadow map it is drawn into at the object: at most 0.75 texels in fact (module notes).
@@ -62,10 +60,7 @@ pub fn shadow_lods(vertices: &[Vertex], indices: &[u32]) -> Vec<ShadowLod> {
         return levels;
     };
     let positions = meshopt::generate_shadow_indices(indices, &adapter);
-    let (lo, hi) = vertices.iter().fold(
-        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-        |(lo, hi), v| (lo.min(v.position.into()), hi.max(v.position.into())),
-    );
+    let (lo, hi) = bounds_of(vertices);
     let diagonal = (hi - lo).length();
     for fraction in LEVEL_DEVIATIONS {
         let mut deviation = 0.0f32;
@@ -108,6 +103,7 @@ pub fn level_for(deviations: impl IntoIterator<Item = f32>, texel: f32, scale: f
 mod tests {
     use super::*;
     use crate::scene_geometry::shared_vertices;
+    use glam::Vec3;
 
     /// A unit sphere of `n` x 2n quads (closed, wound outwards), as triangles.
     fn sphere(n: usize) -> Vec<Vertex> {
