@@ -30,10 +30,7 @@ fn frame(
         light_culling,
         ..Default::default()
     };
-    headless::render_scene_lit(gpu, model, lighting.clone(), 0.0, &options, &|_, _| {})
-        .expect("gpu renders")
-        .images
-        .radiance
+    common::radiance(gpu, model, lighting, &options)
 }
 
 /// An example scene (`assets/scenes/NAME.toml`) with soft shadows.

@@ -100,10 +100,7 @@ fn same_atlas(name: &str, gpu: &GpuContext, model: &SceneModel, lighting: &Scene
             shadow_culling,
             ..Default::default()
         };
-        headless::render_scene_lit(gpu, model, lighting.clone(), 0.0, &options, &|_, _| {})
-            .expect("gpu renders")
-            .images
-            .radiance
+        common::radiance(gpu, model, lighting, &options)
     };
     let (with, without) = (frame(true), frame(false));
     let changed = with

@@ -12,7 +12,7 @@
 mod common;
 
 use ibl_core::{Image, Rgb};
-use ibl_viewer::headless::{self, HeadlessOptions};
+use ibl_viewer::headless::HeadlessOptions;
 use ibl_viewer::lighting::SceneLighting;
 use ibl_viewer::{SceneModel, gpu::GpuContext};
 
@@ -29,10 +29,7 @@ fn frame(
         shadow_levels: levels,
         ..Default::default()
     };
-    headless::render_scene_lit(gpu, model, lighting.clone(), 0.0, &options, &|_, _| {})
-        .expect("gpu renders")
-        .images
-        .radiance
+    common::radiance(gpu, model, lighting, &options)
 }
 
 fn same_frame(name: &str, gpu: &GpuContext, model: &SceneModel, lighting: &SceneLighting) {

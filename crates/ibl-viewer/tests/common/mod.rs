@@ -111,3 +111,16 @@ pub fn as_loaded_and_moved(
     model.translate(0, glam::Vec3::new(0.1, 0.0, -0.05));
     check(&format!("{name}, moved"), model);
 }
+
+/// The radiance of one headless frame of `model` under `lighting`, drawn with `options`.
+pub fn radiance(
+    gpu: &GpuContext,
+    model: &ibl_viewer::SceneModel,
+    lighting: &ibl_viewer::lighting::SceneLighting,
+    options: &ibl_viewer::headless::HeadlessOptions,
+) -> ibl_core::Image<ibl_core::Rgb> {
+    ibl_viewer::headless::render_scene_lit(gpu, model, lighting.clone(), 0.0, options, &|_, _| {})
+        .expect("gpu renders")
+        .images
+        .radiance
+}
